@@ -1,0 +1,12 @@
+// nbvh view — being written (scaffold from the project skeleton; replaced by its issue's work).
+#include "app/commands.h"
+#include "engine/core/error.h"
+
+namespace nbvh::app {
+
+void add_view_command(CLI::App& app) {
+    auto* cmd = app.add_subcommand("view", "(not built yet)");
+    cmd->callback([] { throw Error("'nbvh view' is not built yet"); });
+}
+
+} // namespace nbvh::app

@@ -1,0 +1,15 @@
+// Each subcommand of the `nbvh` executable lives in its own cmd_<name>.cpp and registers itself here.
+// Mains stay thin: parse options, call engine/trainer functions, print.
+#pragma once
+#include <CLI/CLI.hpp>
+
+namespace nbvh::app {
+
+void add_render_command(CLI::App& app);
+void add_train_command(CLI::App& app);
+void add_flip_command(CLI::App& app);
+void add_info_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
+void add_view_command(CLI::App& app);
+
+} // namespace nbvh::app

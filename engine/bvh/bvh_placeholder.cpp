@@ -1,0 +1,1 @@
+// bvh: sources land here

@@ -1,0 +1,1 @@
+// neural: sources land here

@@ -1,0 +1,1 @@
+// vk: sources land here

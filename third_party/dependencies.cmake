@@ -1,0 +1,35 @@
+# Every dependency is a Debian 12 package (see README.md here); this file only finds them and
+# gives each one target name. Included from the top-level CMakeLists.txt.. No third-party source lives in this repository.
+find_package(Vulkan REQUIRED)
+find_package(glm REQUIRED)
+find_package(TinyGLTF REQUIRED)
+find_package(tinyexr REQUIRED)
+find_package(nlohmann_json REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(Threads REQUIRED)
+find_program(NBVH_GLSLC glslc REQUIRED)
+
+add_library(nbvh_deps INTERFACE)
+add_library(nbvh::deps ALIAS nbvh_deps)
+target_link_libraries(nbvh_deps INTERFACE Vulkan::Vulkan glm::glm Threads::Threads)
+
+# tinygltf (Debian ships a shared library with stb_image compiled in)
+add_library(nbvh_tinygltf INTERFACE)
+add_library(nbvh::tinygltf ALIAS nbvh_tinygltf)
+target_link_libraries(nbvh_tinygltf INTERFACE TinyGLTF::TinyGLTF)
+
+# tinyexr (shared library)
+add_library(nbvh_tinyexr INTERFACE)
+add_library(nbvh::tinyexr ALIAS nbvh_tinyexr)
+target_link_libraries(nbvh_tinyexr INTERFACE tinyexr::tinyexr)
+
+# stb (libstb-dev: headers + libstb)
+add_library(nbvh_stb INTERFACE)
+add_library(nbvh::stb ALIAS nbvh_stb)
+target_include_directories(nbvh_stb INTERFACE /usr/include/stb)
+target_link_libraries(nbvh_stb INTERFACE stb)
+
+if(NBVH_BUILD_TESTS)  # (included from the top level so imported targets are global)
+  find_package(GTest REQUIRED)
+  find_package(benchmark QUIET)
+endif()
