@@ -1,1 +1,0 @@
-// neural: sources land here
