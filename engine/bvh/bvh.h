@@ -29,13 +29,24 @@ struct Bvh {
 };
 
 struct BvhBuildOptions {
-    uint32_t max_leaf_size = 4;    // <= NB_LEAF_MAX_COUNT
-    uint32_t bin_count = 16;
+    uint32_t max_leaf_size = 4;    // clamped to [1, NB_LEAF_MAX_COUNT]
+    uint32_t bin_count = 16;       // SAH bins per axis, clamped to [2, 256]
     float traversal_cost = 1.0f;   // SAH cost of visiting a node relative to one primitive test
+    // When > 0, node bounds thinner than this on an axis are padded to it after the build (the N-BVH
+    // base BVH uses BBOX_REGULARISATION = 1e-4, official notes §1); parents are regrown to contain
+    // their padded children. 0 keeps exact bounds (triangle BLAS/TLAS).
+    float min_node_extent = 0.0f;
 };
 
-// SAH build over primitive bounds (binned). Primitives with empty or non-finite bounds are left out.
+// Binned SAH build over primitive bounds. Primitives with empty or non-finite bounds are left out
+// (prim_indices then holds fewer ids than the input). Guarantees: every kept primitive is in exactly
+// one leaf; leaves hold 1..max_leaf_size primitives; node depth < NB_BVH_MAX_DEPTH (falls back to
+// median splits when SAH would go deeper); the two children of a node are adjacent (right = left + 1)
+// and stored after their parent. Throws nbvh::Error for more than 2^27 primitives (GPU leaf refs).
 Bvh build_bvh(std::span<const Aabb> prim_bounds, const BvhBuildOptions& options = {});
+
+// Pads node bounds thinner than `min_extent` (see BvhBuildOptions::min_node_extent) in place.
+void pad_node_bounds(Bvh& bvh, float min_extent);
 
 // Two-child GPU layout; leaf references index `prim_indices` order (callers reorder their primitive
 // arrays by prim_indices so that a leaf's items are contiguous).

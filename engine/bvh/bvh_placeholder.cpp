@@ -1,1 +1,0 @@
-// bvh: sources land here

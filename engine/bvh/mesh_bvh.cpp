@@ -1,0 +1,104 @@
+// Triangle BLAS build and CPU queries (see mesh_bvh.h).
+#include "engine/bvh/mesh_bvh.h"
+
+#include "engine/bvh/aabb_ops.h"
+#include "shaders/shared/intersect.h"
+
+namespace nbvh {
+namespace {
+
+// Vertex positions of triangle `t`, or false when an index is out of range.
+bool triangle_vertices(const Mesh& mesh, uint32_t t, glm::vec3& a, glm::vec3& b, glm::vec3& c) {
+    const size_t n = mesh.positions.size();
+    const uint32_t i0 = mesh.indices[3 * size_t(t)], i1 = mesh.indices[3 * size_t(t) + 1],
+                   i2 = mesh.indices[3 * size_t(t) + 2];
+    if (i0 >= n || i1 >= n || i2 >= n) return false;
+    a = mesh.positions[i0];
+    b = mesh.positions[i1];
+    c = mesh.positions[i2];
+    return true;
+}
+
+} // namespace
+
+BvhBuildOptions default_blas_options() {
+    BvhBuildOptions o;
+    o.max_leaf_size = 4;
+    o.bin_count = 16;
+    o.traversal_cost = 1.0f;
+    return o;
+}
+
+MeshBvh build_mesh_bvh(const Mesh& mesh, const BvhBuildOptions& options) {
+    const uint32_t tri_count = mesh.triangle_count();
+    std::vector<Aabb> bounds(tri_count); // empty (skipped) unless the triangle is valid
+    for (uint32_t t = 0; t < tri_count; ++t) {
+        glm::vec3 a, b, c;
+        if (!triangle_vertices(mesh, t, a, b, c)) continue;
+        Aabb box;
+        box.grow(a);
+        box.grow(b);
+        box.grow(c);
+        if (is_finite(box)) bounds[t] = box;
+    }
+    MeshBvh out;
+    out.bvh = build_bvh(bounds, options);
+    out.vertices.resize(3 * out.bvh.prim_indices.size());
+    for (size_t k = 0; k < out.bvh.prim_indices.size(); ++k) {
+        triangle_vertices(mesh, out.bvh.prim_indices[k], out.vertices[3 * k], out.vertices[3 * k + 1],
+                          out.vertices[3 * k + 2]);
+    }
+    return out;
+}
+
+namespace {
+
+// Shared by closest and any hit: `any` stops at the first accepted triangle.
+template <bool any>
+bool intersect(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit) {
+    bool found = false;
+    const glm::vec3* v = mesh.vertices.data();
+    const Bvh& bvh = mesh.bvh;
+    traverse(bvh, ray, tmin, tmax, [&](uint32_t ni, float, float& t_max) {
+        const BvhNode& n = bvh.nodes[ni];
+        for (uint32_t k = n.first; k < n.first + n.count; ++k) {
+            float t, u, w;
+            if (nb_intersect_triangle(ray.org, ray.dir, v[3 * k], v[3 * k + 1], v[3 * k + 2], tmin, t_max, t, u, w)) {
+                found = true;
+                t_max = t;
+                hit = Hit{t, bvh.prim_indices[k], u, w};
+                if (any) return true;
+            }
+        }
+        return false;
+    });
+    return found;
+}
+
+} // namespace
+
+bool intersect_closest(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit) {
+    return intersect<false>(mesh, ray, tmin, tmax, hit);
+}
+
+bool intersect_any(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax) {
+    Hit h;
+    return intersect<true>(mesh, ray, tmin, tmax, h);
+}
+
+bool intersect_closest_brute_force(const Mesh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit) {
+    bool found = false;
+    for (uint32_t tri = 0; tri < mesh.triangle_count(); ++tri) {
+        glm::vec3 a, b, c;
+        if (!triangle_vertices(mesh, tri, a, b, c)) continue;
+        float t, u, v;
+        if (nb_intersect_triangle(ray.org, ray.dir, a, b, c, tmin, tmax, t, u, v)) {
+            found = true;
+            tmax = t;
+            hit = Hit{t, tri, u, v};
+        }
+    }
+    return found;
+}
+
+} // namespace nbvh

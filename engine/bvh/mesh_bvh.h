@@ -1,0 +1,44 @@
+// Per-mesh triangle BVH (BLAS) with triangle vertices reordered into leaf order, and its CPU
+// closest-hit / any-hit queries (used by tests, by the renderer's GPU-vs-CPU check and by the CPU
+// trainer for ground truth). The renderer uploads to_gpu_layout(bvh) plus `vertices` (or its own
+// attribute arrays reordered by bvh.prim_indices).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "engine/bvh/bvh.h"
+#include "engine/bvh/traverse.h"
+#include "engine/scene/scene.h"
+
+namespace nbvh {
+
+struct MeshBvh {
+    Bvh bvh; // primitive ids are triangle indices of the source Mesh
+    // 3 vertices per triangle, in bvh.prim_indices order: triangle k of the leaf order has vertices
+    // vertices[3k..3k+2] and original id bvh.prim_indices[k]. Triangles the builder skipped
+    // (non-finite vertices, out-of-range indices) are not present.
+    std::vector<glm::vec3> vertices;
+    uint32_t triangle_count() const { return uint32_t(bvh.prim_indices.size()); }
+    Aabb bounds() const { return bvh.empty() ? Aabb{} : bvh.nodes[0].bounds; }
+};
+
+struct Hit {
+    float t = NB_INF;          // ray parameter (units of |dir|)
+    uint32_t triangle = BVH_INVALID; // index in the ORIGINAL mesh triangle order
+    float u = 0.0f, v = 0.0f;  // barycentrics: p = (1-u-v) v0 + u v1 + v v2
+};
+
+// Default options for triangle BLAS.
+BvhBuildOptions default_blas_options();
+
+MeshBvh build_mesh_bvh(const Mesh& mesh, const BvhBuildOptions& options = default_blas_options());
+
+// Closest hit with t in [tmin, tmax]; `hit` is written only when it returns true.
+bool intersect_closest(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit);
+// Any hit with t in [tmin, tmax] (shadow rays).
+bool intersect_any(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax);
+
+// Reference: tests every triangle of `mesh` (same intersect.h math). For tests and debugging.
+bool intersect_closest_brute_force(const Mesh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit);
+
+} // namespace nbvh
