@@ -1,0 +1,160 @@
+// The Vulkan context: instance, validation messenger, physical-device choice, one logical device with
+// one compute queue, and the device features the renderer branches on. Compute only (no surface).
+//
+// Everything device-owned (buffers, images, pipelines, command buffers) keeps a `const Context&` and
+// must be destroyed before the Context; member order in the owner gives that for free.
+#pragma once
+#include "engine/core/error.h"
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace nbvh::vk {
+
+// Name of a VkResult ("VK_ERROR_DEVICE_LOST"), or its number when unknown.
+const char* result_name(VkResult result);
+[[noreturn]] void fail_vk(const char* file, int line, const char* expr, VkResult result);
+
+} // namespace nbvh::vk
+
+// A failed Vulkan call is a broken invariant: abort with file, line, expression and the result's name.
+// Always on. (No Vulkan / unsupported device is a user error: Context throws nbvh::Error instead.)
+#define NBVH_VK_CHECK(expr)                                                                       \
+    do {                                                                                          \
+        VkResult nbvh_vk_result_ = (expr);                                                        \
+        if (nbvh_vk_result_ != VK_SUCCESS)                                                        \
+            ::nbvh::vk::fail_vk(__FILE__, __LINE__, #expr, nbvh_vk_result_);                      \
+    } while (0)
+
+namespace nbvh::vk {
+
+// --device auto|gpu|cpu. auto prefers a real GPU (discrete, then integrated, then virtual) and falls
+// back to a CPU implementation (Mesa lavapipe); gpu fails without a GPU; cpu picks lavapipe.
+enum class DeviceChoice { automatic, gpu, cpu };
+DeviceChoice parse_device_choice(std::string_view text); // throws Error on anything else
+const char* device_choice_name(DeviceChoice choice);
+
+struct ContextOptions {
+    DeviceChoice device = DeviceChoice::automatic;
+    // Khronos validation layer + debug messenger. Also switched on by NBVH_VALIDATION=1 in the
+    // environment (NBVH_VALIDATION=0 switches it off). Debug builds default to on.
+#ifdef NDEBUG
+    bool validation = false;
+#else
+    bool validation = true;
+#endif
+};
+
+// One supported VK_NV_cooperative_matrix configuration (D = A*B + C, A is MxK, B is KxN).
+struct CoopMatrixShape {
+    uint32_t m = 0, n = 0, k = 0;
+    VkComponentTypeNV a = VK_COMPONENT_TYPE_FLOAT16_NV, b = VK_COMPONENT_TYPE_FLOAT16_NV;
+    VkComponentTypeNV c = VK_COMPONENT_TYPE_FLOAT16_NV, d = VK_COMPONENT_TYPE_FLOAT16_NV;
+    VkScopeNV scope = VK_SCOPE_SUBGROUP_NV;
+    std::string describe() const; // "16x16x16 f16*f16+f16->f16 subgroup"
+};
+
+// What the chosen device can do. Every `bool` here is also *enabled* on the logical device when true.
+struct DeviceFeatures {
+    std::string device_name;
+    std::string driver_name; // e.g. "llvmpipe" / "NVIDIA" (VkPhysicalDeviceVulkan12Properties)
+    std::string driver_info; // driver version text as the driver reports it
+    uint32_t api_version = 0;
+    uint32_t driver_version = 0;
+    uint32_t vendor_id = 0;
+    bool is_cpu = false; // a software implementation (lavapipe)
+
+    bool fp16 = false;           // shaderFloat16
+    bool int8 = false;           // shaderInt8
+    bool int16 = false;          // shaderInt16
+    bool int64 = false;          // shaderInt64
+    bool storage16 = false;      // storageBuffer16BitAccess
+    bool storage8 = false;       // storageBuffer8BitAccess
+    bool scalar_layout = false;  // scalarBlockLayout (required: every shared struct uses it)
+    bool buffer_device_address = false;
+    bool memory_model = false;   // vulkanMemoryModel
+    bool descriptor_partially_bound = false; // texture arrays may leave slots unwritten
+    bool subgroup_size_control = false;
+    bool coop_matrix_nv = false; // VK_NV_cooperative_matrix
+    std::vector<CoopMatrixShape> coop_matrix_shapes;
+
+    uint32_t subgroup_size = 0;
+    uint32_t min_subgroup_size = 0, max_subgroup_size = 0; // equal to subgroup_size without control
+    uint32_t max_shared_memory = 0;          // bytes per workgroup
+    uint64_t max_storage_buffer_range = 0;   // bytes per storage-buffer binding
+    uint64_t max_allocation_size = 0;        // bytes per VkDeviceMemory
+    uint32_t max_push_constants = 0;         // bytes
+    uint32_t max_workgroup_invocations = 0;
+    uint32_t max_workgroup_count[3] = {0, 0, 0};
+    float timestamp_period = 0.0f;           // nanoseconds per timestamp tick
+    uint32_t timestamp_valid_bits = 0;       // of the compute queue; 0 = no timestamps
+
+    std::string summary() const; // multi-line, for `nbvh info` and logs
+};
+
+class Context {
+public:
+    explicit Context(const ContextOptions& options = {});
+    ~Context();
+    Context(Context&& other) noexcept;
+    Context& operator=(Context&& other) noexcept;
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
+
+    VkInstance instance() const { return instance_; }
+    VkPhysicalDevice physical_device() const { return physical_; }
+    VkDevice device() const { return device_; }
+    VkQueue queue() const { return queue_; }
+    uint32_t queue_family() const { return queue_family_; }
+    const DeviceFeatures& features() const { return features_; }
+
+    // Validation: whether the layer is active, and how many warnings + errors it reported so far
+    // (each is also logged). Tests assert this stays 0.
+    bool validation_enabled() const { return messenger_ != VK_NULL_HANDLE; }
+    int validation_message_count() const;
+    void reset_validation_message_count();
+
+    // A memory type with all `required` flags (and all `preferred` ones when such a type exists).
+    // Aborts when none fits `required` (every device has device-local and host-visible memory).
+    uint32_t find_memory_type(uint32_t type_bits, VkMemoryPropertyFlags required,
+                              VkMemoryPropertyFlags preferred = 0) const;
+
+    // Debug names and labels (no-ops when VK_EXT_debug_utils is unavailable).
+    void set_name(VkObjectType type, uint64_t handle, const char* name) const;
+    template <class Handle> void set_name(VkObjectType type, Handle handle, const std::string& name) const {
+        set_name(type, reinterpret_cast<uint64_t>(handle), name.c_str());
+    }
+    void begin_label(VkCommandBuffer cmd, const char* name) const;
+    void end_label(VkCommandBuffer cmd) const;
+
+    // Record with `record`, submit to the queue and wait (uploads, downloads, one-off work).
+    void run_now(const std::function<void(VkCommandBuffer)>& record) const;
+
+    void wait_idle() const;
+
+private:
+    struct Debug; // heap-held so the messenger's user pointer survives moves
+    void destroy();
+    void create_instance(bool validation);
+    void pick_physical_device(DeviceChoice choice);
+    void create_device();
+
+    std::unique_ptr<Debug> debug_;
+    VkInstance instance_ = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+    VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+    VkDevice device_ = VK_NULL_HANDLE;
+    VkQueue queue_ = VK_NULL_HANDLE;
+    uint32_t queue_family_ = 0;
+    VkCommandPool transient_pool_ = VK_NULL_HANDLE; // for run_now
+    VkPhysicalDeviceMemoryProperties memory_{};
+    DeviceFeatures features_;
+};
+
+} // namespace nbvh::vk

@@ -1,1 +1,0 @@
-// vk: sources land here
