@@ -24,6 +24,7 @@ struct Texture {
     std::string name;
     uint32_t width = 0, height = 0;
     std::vector<uint8_t> rgba8; // width*height*4, row-major, top row first
+    bool srgb = false;          // used as base colour / emissive (decode sRGB on fetch); else linear data
 };
 
 // Reference to a texture with its UV set and KHR_texture_transform, as uv' = M * (uv, 1).

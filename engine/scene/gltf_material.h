@@ -1,0 +1,34 @@
+// glTF materials and textures -> nbvh::Material / nbvh::Texture (internal to the glTF loader).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "engine/scene/scene.h"
+
+namespace tinygltf {
+class Model;
+struct Image;
+} // namespace tinygltf
+
+namespace nbvh::gltf {
+
+// State of tinygltf's image callback: we decode with stb_image ourselves so that a broken image is a
+// warning (the material then goes without that texture), never a failed load, and so that textures can
+// be skipped entirely (keep_textures = false: geometry-only loads for the trainer).
+struct ImageDecodeContext {
+    bool decode = true;
+    int failures = 0;
+};
+
+// Matches tinygltf::LoadImageDataFunction. Always returns true; failures leave the image empty with a warning.
+bool decode_image(tinygltf::Image* image, int image_index, std::string* err, std::string* warn, int req_width,
+                  int req_height, const unsigned char* bytes, int size, void* user_data);
+
+// Fills scene.materials (one per glTF material, then one default material appended last) and
+// scene.textures (one per decoded glTF image that a material uses). Returns the default material's index.
+uint32_t convert_materials(const tinygltf::Model& model, bool keep_textures, Scene& scene);
+
+// uv' = M * (uv, 1) for KHR_texture_transform (offset, rotation in radians, scale), as the extension's spec.
+glm::mat3 texture_transform(glm::vec2 offset, float rotation, glm::vec2 scale);
+
+} // namespace nbvh::gltf
