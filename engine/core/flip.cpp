@@ -35,17 +35,22 @@ void parallel_rows(int height, const F& fn) {
 }
 
 // 1-D correlation along x with clamp-to-edge: out(x) = Σ_{i=-r..r} k[i+r]·in(clamp(x+i)).
+// The row is copied into an edge-padded buffer so the tap loop runs over x (vectorises); each
+// output still sums its taps in the order -r..r.
 void conv_x(const Plane& in, Plane& out, int w, int h, const std::vector<float>& k) {
     const int r = int(k.size() / 2);
     out.resize(in.size());
     parallel_rows(h, [&](int y0, int y1) {
+        std::vector<float> pad(static_cast<size_t>(w + 2 * r));
         for (int y = y0; y < y1; ++y) {
             const float* row = in.data() + size_t(y) * w;
+            for (int x = -r; x < w + r; ++x) pad[size_t(x + r)] = row[std::clamp(x, 0, w - 1)];
             float* o = out.data() + size_t(y) * w;
-            for (int x = 0; x < w; ++x) {
-                float s = 0.0f;
-                for (int i = -r; i <= r; ++i) s += k[i + r] * row[std::clamp(x + i, 0, w - 1)];
-                o[x] = s;
+            std::fill(o, o + w, 0.0f);
+            for (int i = 0; i <= 2 * r; ++i) {
+                const float kk = k[i];
+                const float* src = pad.data() + i;
+                for (int x = 0; x < w; ++x) o[x] += kk * src[x];
             }
         }
     });
