@@ -1,12 +1,128 @@
-// nbvh train — being written (scaffold from the project skeleton; replaced by its issue's work).
+// nbvh train SCENE: learns the N-BVH of the scene's neural asset and writes MODEL.nbvh.
+// SCENE is a glTF file or "default" (the built-in demo scene, assets/). Which assets are neural follows
+// ARCHITECTURE.md: the nodes of a "*_neural" glTF scene, or --neural GLOB.
+#include <filesystem>
+#include <string>
+
 #include "app/commands.h"
+#if __has_include("assets/default_scene.h")
+#include "assets/default_scene.h"
+#define NBVH_HAVE_DEFAULT_SCENE 1
+#endif
 #include "engine/core/error.h"
+#include "engine/core/log.h"
+#include "engine/neural/model_file.h"
+#include "engine/scene/gltf_loader.h"
+#include "trainer/model_export.h"
+#include "trainer/progress_bar.h"
+#include "trainer/trainer.h"
 
 namespace nbvh::app {
 
+namespace {
+
+struct TrainArgs {
+    std::string scene;
+    std::string neural_glob;
+    std::string out;
+    std::string backend = "auto";
+    std::string log_csv;
+    // 0 = the backend's default.
+    uint32_t nodes = 0, hash_log2 = 0, steps = 0, batch = 0, lods = 1, threads = 0;
+    uint64_t seed = 1337;
+};
+
+BackendChoice parse_backend(const std::string& s) {
+    if (s == "cpu") return BackendChoice::cpu;
+    if (s == "cuda") return BackendChoice::cuda;
+    if (s == "auto") return BackendChoice::automatic;
+    throw Error(strfmt("--backend must be cpu, cuda or auto (got '%s')", s.c_str()));
+}
+
+void run_train(const TrainArgs& a) {
+    const BackendChoice backend = resolve_backend(parse_backend(a.backend));
+    TrainOptions opt = default_train_options(backend);
+    if (a.nodes) opt.target_nodes = a.nodes;
+    if (a.hash_log2) opt.network.log2_hash_size = a.hash_log2;
+    if (a.steps) opt.steps = a.steps;
+    if (a.batch) opt.batch_size = a.batch;
+    opt.lods = a.lods;
+    opt.seed = a.seed;
+    opt.threads = a.threads;
+    validate(opt);
+
+    Scene scene;
+    uint64_t source_hash = 0;
+    if (a.scene == "default") {
+#if defined(NBVH_HAVE_DEFAULT_SCENE)
+        scene = assets::make_default_scene();
+#else
+        throw Error("this build has no built-in default scene; pass a glTF file");
+#endif
+        if (!a.neural_glob.empty()) mark_neural_by_glob(scene, a.neural_glob);
+    } else {
+        SceneLoadOptions lo;
+        lo.neural_glob = a.neural_glob;
+        lo.require_geometry = true;
+        scene = load_gltf(a.scene, lo);
+        source_hash = fnv1a64_file(a.scene);
+    }
+    const uint32_t mesh = pick_neural_mesh(scene);
+    uint32_t neural_meshes = 0;
+    {
+        std::vector<bool> seen(scene.meshes.size(), false);
+        for (const Instance& inst : scene.instances)
+            if (inst.neural && inst.mesh < seen.size() && !seen[inst.mesh]) seen[inst.mesh] = true, neural_meshes++;
+    }
+    if (neural_meshes > 1)
+        log_warn("%u neural meshes: this version trains one model per run, for the largest ('%s')", neural_meshes,
+                 scene.meshes[mesh].name.c_str());
+    const TrainingAsset asset = make_training_asset(scene, mesh);
+
+    const std::string out = a.out.empty()
+                                ? (a.scene == "default" ? std::string("default.nbvh")
+                                                        : std::filesystem::path(a.scene).stem().string() + ".nbvh")
+                                : a.out;
+    const SplitSchedule schedule = make_split_schedule(opt);
+    log_info("training '%s' (%u triangles) on %s: %u steps x %u rays, target %u nodes, hash 2^%u, %u LoD(s); %s",
+             asset.name.c_str(), asset.triangle_count(), backend == BackendChoice::cuda ? "cuda" : "cpu", opt.steps,
+             opt.batch_size, opt.target_nodes, opt.network.log2_hash_size, opt.lods, describe(schedule).c_str());
+
+    std::unique_ptr<TrainerBackend> be = make_backend(backend, asset, opt);
+    ProgressBar bar;
+    TrainResult result = train_asset(asset, opt, *be, [&](const TrainProgress& p) { bar.update(p); });
+    bar.finish();
+
+    if (!a.log_csv.empty()) write_train_log_csv(result.log, a.log_csv);
+    const NeuralModel model = make_neural_model(asset, result, opt, a.scene, source_hash);
+    save_model(out, model);
+    const LossTerms& l = result.log.back().loss;
+    log_info("wrote %s: %u nodes, %u leaves, final loss %.4f (vis %.4f, depth %.4f, normal %.4f, albedo %.4f), "
+             "%s, %.0f samples/s%s",
+             out.c_str(), result.tree.node_count(), result.tree.leaf_count(), l.total, l.visibility, l.depth,
+             l.normal, l.albedo, format_duration(result.seconds).c_str(), result.samples_per_s,
+             result.skipped_steps ? strfmt(", %u steps skipped", result.skipped_steps).c_str() : "");
+}
+
+} // namespace
+
 void add_train_command(CLI::App& app) {
-    auto* cmd = app.add_subcommand("train", "(not built yet)");
-    cmd->callback([] { throw Error("'nbvh train' is not built yet"); });
+    auto args = std::make_shared<TrainArgs>();
+    auto* cmd = app.add_subcommand("train", "learn the N-BVH of a scene's neural asset and write a .nbvh model");
+    cmd->add_option("scene", args->scene, "glTF scene (.gltf/.glb), or 'default' for the built-in demo scene")
+        ->required();
+    cmd->add_option("--neural", args->neural_glob, "glob of node names to make neural (overrides '*_neural' scenes)");
+    cmd->add_option("--out,-o", args->out, "output model (default: SCENE.nbvh in the current directory)");
+    cmd->add_option("--backend", args->backend, "cpu, cuda or auto (default: auto = cuda when a GPU is usable)");
+    cmd->add_option("--nodes", args->nodes, "target N-BVH node count (CPU default 1000, CUDA 2395)");
+    cmd->add_option("--hash-log2", args->hash_log2, "log2 of the hash-table entries per level (CPU 15, CUDA 18)");
+    cmd->add_option("--steps", args->steps, "optimiser steps (CPU default 1500, CUDA 10000)");
+    cmd->add_option("--batch", args->batch, "rays per step (CPU default 4096, CUDA 262144)");
+    cmd->add_option("--lods", args->lods, "cuts kept as levels of detail (1..8)");
+    cmd->add_option("--seed", args->seed, "random seed (network init and rays)");
+    cmd->add_option("--threads", args->threads, "CPU backend threads (default: all cores)");
+    cmd->add_option("--log", args->log_csv, "write a CSV log of the losses and node count per step");
+    cmd->callback([args] { run_train(*args); });
 }
 
 } // namespace nbvh::app

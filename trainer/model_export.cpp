@@ -1,0 +1,38 @@
+#include "trainer/model_export.h"
+
+#include <ctime>
+
+#include "engine/core/error.h"
+
+namespace nbvh {
+
+NeuralModel make_neural_model(const TrainingAsset& asset, const TrainResult& result, const TrainOptions& options,
+                              const std::string& source, uint64_t source_hash) {
+    NBVH_CHECK(result.tree.frozen());
+    NeuralModel m;
+    m.cfg = result.weights.cfg;
+    m.levels = result.weights.levels;
+    m.asset_name = asset.name;
+    m.encoding_box = asset.bounds; // the renderer rebuilds GpuEncodingBox with nb_make_encoding_box
+    set_tree(m, result.tree);
+    m.mlp = neural::mlp_to_fp16(result.weights);
+    m.grid = neural::grid_to_fp16(result.weights);
+    TrainingMetadata& meta = m.meta;
+    meta.steps = result.log.size();
+    meta.final_loss = result.log.empty() ? 0.0f : float(result.log.back().loss.total);
+    meta.seconds = result.seconds;
+    meta.batch_size = options.batch_size;
+    meta.backend = result.backend;
+    meta.source = source;
+    meta.source_hash = source_hash;
+    meta.created_unix = int64_t(std::time(nullptr));
+    const SplitSchedule s = make_split_schedule(options);
+    meta.splitting_interval = s.splitting_interval;
+    meta.last_split_iteration = s.last_split_iteration;
+    meta.start_split_num = s.start_split_num;
+    meta.split_scaling = s.split_scaling;
+    meta.split_interval_scaling = s.split_interval_scaling;
+    return m;
+}
+
+} // namespace nbvh
