@@ -1,0 +1,64 @@
+// Field lists of every GPU-shared struct, for the layout test (tests/vk/layout_test.cpp with
+// shaders/tests/layout.comp). Included by both: the shader fills each struct through these lists and
+// writes it to a scalar-layout buffer; the C++ build fills the same struct with the same values, and
+// the test compares the two field by field (by name) and byte by byte. A field whose GLSL offset
+// differs from its C++ offset, a wrong struct size (array stride) or a field missing from a list shows
+// up as a named mismatch.
+//
+// To add a struct GpuFoo from shaders/shared/foo.h:
+//   1. include foo.h below;
+//   2. write NB_LAYOUT_FIELDS_GpuFoo(F) listing EVERY field as F(name) (nested struct members as
+//      F(inner.member), array elements as F(arr[0]) F(arr[1]) ...);
+//   3. add S(GpuFoo, <next binding>) to NB_LAYOUT_STRUCTS.
+// Supported field types: float, int, uint, vec2-4, ivec2-4, uvec2-4 (add an nb_lv overload for more).
+#ifndef NB_LAYOUT_FIELDS_H
+#define NB_LAYOUT_FIELDS_H
+#include "../shared/compat.h"
+#include "../shared/bvh_node.h"
+#include "../shared/hashgrid.h"
+#include "../shared/neural_query.h"
+
+// --- every struct (name, binding in layout.comp) ------------------------------------------------
+#define NB_LAYOUT_STRUCTS(S) \
+    S(GpuBvhNode, 0)         \
+    S(GpuHashLevel, 1)       \
+    S(GpuEncodingBox, 2)
+
+// --- field lists ---------------------------------------------------------------------------------
+#define NB_LAYOUT_FIELDS_GpuBvhNode(F) \
+    F(lmin) F(left) F(lmax) F(right) F(rmin) F(pad0) F(rmax) F(pad1)
+#define NB_LAYOUT_FIELDS_GpuHashLevel(F) \
+    F(offset) F(size) F(resolution) F(scale) F(hashed) F(pad0) F(pad1) F(pad2)
+#define NB_LAYOUT_FIELDS_GpuEncodingBox(F) \
+    F(center) F(depth_pad) F(extent) F(fixed_depth_eps)
+
+// --- distinct, exactly representable, non-zero values ------------------------------------------
+// Field number k gets base value 16k (+1 for each further component), so every 4-byte word of a
+// filled struct differs from every other (and from the zero the output buffer starts with).
+NB_FN void nb_lv(NB_OUT(uint) x, uint k) { x = 16u * k + 1u; }
+NB_FN void nb_lv(NB_OUT(int) x, uint k) { x = -int(16u * k + 1u); }
+NB_FN void nb_lv(NB_OUT(float) x, uint k) { x = float(16u * k + 1u) + 0.5f; }
+NB_FN void nb_lv(NB_OUT(vec2) x, uint k) { nb_lv(x.x, k); x.y = x.x + 1.0f; }
+NB_FN void nb_lv(NB_OUT(vec3) x, uint k) { nb_lv(x.x, k); x.y = x.x + 1.0f; x.z = x.x + 2.0f; }
+NB_FN void nb_lv(NB_OUT(vec4) x, uint k) { nb_lv(x.x, k); x.y = x.x + 1.0f; x.z = x.x + 2.0f; x.w = x.x + 3.0f; }
+NB_FN void nb_lv(NB_OUT(uvec2) x, uint k) { nb_lv(x.x, k); x.y = x.x + 1u; }
+NB_FN void nb_lv(NB_OUT(uvec3) x, uint k) { nb_lv(x.x, k); x.y = x.x + 1u; x.z = x.x + 2u; }
+NB_FN void nb_lv(NB_OUT(uvec4) x, uint k) { nb_lv(x.x, k); x.y = x.x + 1u; x.z = x.x + 2u; x.w = x.x + 3u; }
+NB_FN void nb_lv(NB_OUT(ivec2) x, uint k) { nb_lv(x.x, k); x.y = x.x - 1; }
+NB_FN void nb_lv(NB_OUT(ivec3) x, uint k) { nb_lv(x.x, k); x.y = x.x - 1; x.z = x.x - 2; }
+NB_FN void nb_lv(NB_OUT(ivec4) x, uint k) { nb_lv(x.x, k); x.y = x.x - 1; x.z = x.x - 2; x.w = x.x - 3; }
+
+// nb_layout_fill_GpuFoo(s, seed): every field of s from the list; seed (the array element) shifts
+// all values so that element 1 differs from element 0 (this checks the array stride = struct size).
+#define NB_LV_FIELD(f) nb_lv(s.f, k); k += 1u;
+#define NB_LAYOUT_FILL_FN(T, binding)                                                             \
+    NB_FN void nb_layout_fill_##T(NB_OUT(T) s, uint seed) {                                       \
+        uint k = 1u + seed * 4096u;                                                               \
+        NB_LAYOUT_FIELDS_##T(NB_LV_FIELD)                                                         \
+    }
+NB_LAYOUT_STRUCTS(NB_LAYOUT_FILL_FN)
+
+// Elements written per struct by layout.comp (one invocation each).
+#define NB_LAYOUT_ELEMENTS 2u
+
+#endif // NB_LAYOUT_FIELDS_H
