@@ -16,6 +16,7 @@
 #include "engine/core/log.h"
 #include "engine/scene/gltf_accessor.h"
 #include "engine/scene/gltf_material.h"
+#include "engine/scene/gltf_schema.h"
 #include "engine/scene/mesh_builder.h"
 #include "engine/scene/scene_stats.h"
 
@@ -51,6 +52,21 @@ tinygltf::Model parse_file(const std::filesystem::path& path, bool keep_textures
             shown += std::isprint(static_cast<unsigned char>(magic[i])) ? magic[i] : '?';
         throw Error(strfmt("%s: not a GLB file (magic '%s', expected 'glTF')", file.c_str(), shown.c_str()));
     }
+    if (binary) {
+        // GLB header (magic, version, total length): tinygltf's message for a cut file is only "Invalid glTF
+        // binary", so say what is wrong here.
+        uint32_t header[2] = {0, 0};
+        in.read(reinterpret_cast<char*>(header), sizeof header);
+        std::error_code ec;
+        const uint64_t size = std::filesystem::file_size(path, ec);
+        if (in.gcount() != sizeof header || ec)
+            throw Error(strfmt("%s: truncated GLB (no complete 12-byte header)", file.c_str()));
+        if (header[0] != 2)
+            throw Error(strfmt("%s: unsupported GLB version %u (expected 2)", file.c_str(), header[0]));
+        if (header[1] > size)
+            throw Error(strfmt("%s: truncated GLB: header says %u bytes, file has %llu", file.c_str(), header[1],
+                               (unsigned long long)size));
+    }
     in.close();
 
     tinygltf::TinyGLTF loader;
@@ -64,6 +80,7 @@ tinygltf::Model parse_file(const std::filesystem::path& path, bool keep_textures
     for (std::string line; std::getline(lines, line);)
         if (!line.empty()) log_warn("%s: %s", path.filename().string().c_str(), line.c_str());
     if (!ok) throw Error(strfmt("%s: %s", file.c_str(), first_line(err).c_str()));
+    gltf::check_schema(path);
     return model;
 }
 

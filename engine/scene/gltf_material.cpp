@@ -93,10 +93,12 @@ struct TextureTable {
 } // namespace
 
 glm::mat3 texture_transform(glm::vec2 offset, float rotation, glm::vec2 scale) {
-    // Column-major, exactly the GLSL of the KHR_texture_transform specification.
+    // Column-major. The rotation is the transpose of the one in the extension's GLSL listing, which is known
+    // to be wrong (KhronosGroup/glTF#1563): glTF UVs have v down, and Blender, Babylon.js, three.js and the
+    // extension's own example ("offset [0,1], rotation pi/2, scale 0.5 = lower-left quadrant") all use this.
     const float c = std::cos(rotation), s = std::sin(rotation);
     const glm::mat3 translation(1, 0, 0, 0, 1, 0, offset.x, offset.y, 1);
-    const glm::mat3 rot(c, s, 0, -s, c, 0, 0, 0, 1);
+    const glm::mat3 rot(c, -s, 0, s, c, 0, 0, 0, 1);
     const glm::mat3 scl(scale.x, 0, 0, 0, scale.y, 0, 0, 0, 1);
     return translation * rot * scl;
 }

@@ -28,7 +28,8 @@ bool decode_image(tinygltf::Image* image, int image_index, std::string* err, std
 // scene.textures (one per decoded glTF image that a material uses). Returns the default material's index.
 uint32_t convert_materials(const tinygltf::Model& model, bool keep_textures, Scene& scene);
 
-// uv' = M * (uv, 1) for KHR_texture_transform (offset, rotation in radians, scale), as the extension's spec.
+// uv' = M * (uv, 1) for KHR_texture_transform (offset, rotation in radians, scale): M = T * R * S with the
+// rotation direction of glTF#1563 (see the .cpp).
 glm::mat3 texture_transform(glm::vec2 offset, float rotation, glm::vec2 scale);
 
 } // namespace nbvh::gltf
