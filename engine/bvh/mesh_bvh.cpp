@@ -35,11 +35,13 @@ MeshBvh build_mesh_bvh(const Mesh& mesh, const BvhBuildOptions& options) {
     for (uint32_t t = 0; t < tri_count; ++t) {
         glm::vec3 a, b, c;
         if (!triangle_vertices(mesh, t, a, b, c)) continue;
+        // Aabb::grow drops NaN (glm min/max), so test the vertices themselves.
+        if (!is_finite(a) || !is_finite(b) || !is_finite(c)) continue;
         Aabb box;
         box.grow(a);
         box.grow(b);
         box.grow(c);
-        if (is_finite(box)) bounds[t] = box;
+        bounds[t] = box;
     }
     MeshBvh out;
     out.bvh = build_bvh(bounds, options);
@@ -90,7 +92,7 @@ bool intersect_closest_brute_force(const Mesh& mesh, const Ray& ray, float tmin,
     bool found = false;
     for (uint32_t tri = 0; tri < mesh.triangle_count(); ++tri) {
         glm::vec3 a, b, c;
-        if (!triangle_vertices(mesh, tri, a, b, c)) continue;
+        if (!triangle_vertices(mesh, tri, a, b, c) || !is_finite(a) || !is_finite(b) || !is_finite(c)) continue;
         float t, u, v;
         if (nb_intersect_triangle(ray.org, ray.dir, a, b, c, tmin, tmax, t, u, v)) {
             found = true;

@@ -14,9 +14,11 @@
 
 // Directions whose component magnitude is below this are treated as parallel to that axis.
 #define NB_PARALLEL_EPS 1.0e-30f
-// Conservative slab test: each axis' exit distance is scaled by (1 + 2 gamma(3)) (pbrt-v4 §6.8.2),
-// so rounding never makes a ray miss a box that tightly bounds a triangle it hits (grazing rays).
-#define NB_SLAB_FAR_SCALE 1.0000008f
+// Conservative slab test: each axis' entry distance is moved towards -inf and its exit towards +inf
+// by this relative amount (about 17 float ulps; pbrt-v4 §6.8.2 uses 2 gamma(3) on the exit only), so
+// rounding never makes a ray miss, or a closest-hit traversal cull, a box that tightly bounds a
+// triangle the ray hits (grazing rays, face-on flat boxes, coplanar triangles).
+#define NB_SLAB_SLACK 2.0e-6f
 
 // Reciprocal direction that never divides by zero: components with |d| < NB_PARALLEL_EPS become
 // +-NB_INF (a finite float), which nb_intersect_aabb* read as "parallel". Use this on the GPU, where
@@ -40,10 +42,13 @@ NB_FN void nb_clip_slab(float o, float inv, float lo, float hi, NB_INOUT(float) 
     }
     float t0 = (lo - o) * inv;
     float t1 = (hi - o) * inv;
-    float tn = min(t0, t1);
-    float tf = max(t0, t1) * NB_SLAB_FAR_SCALE;
-    // A far value behind the origin must not move further away from zero by the scale.
-    if (tf < 0.0f) tf = max(t0, t1) * (2.0f - NB_SLAB_FAR_SCALE);
+    // Ternaries instead of min/max: with a NaN (only from a NaN ray) tn <= tf below is false.
+    float tn = t0 < t1 ? t0 : t1;
+    float tf = t0 < t1 ? t1 : t0;
+    if (!(tn <= tf)) { t_near = NB_INF; t_far = -NB_INF; return; }
+    // Widen by NB_SLAB_SLACK (multiplicative: infinities stay infinite, never NaN).
+    tn = tn * (tn > 0.0f ? (1.0f - NB_SLAB_SLACK) : (1.0f + NB_SLAB_SLACK));
+    tf = tf * (tf < 0.0f ? (1.0f - NB_SLAB_SLACK) : (1.0f + NB_SLAB_SLACK));
     t_near = max(t_near, tn);
     t_far = min(t_far, tf);
 }
@@ -76,11 +81,15 @@ NB_FN bool nb_intersect_aabb(vec3 org, vec3 inv_dir, vec3 lo, vec3 hi, float tmi
 // without the double-precision fallback: an edge function that rounds to zero counts as "on the
 // edge" and hits, so rays through a shared edge or vertex hit at least one of the triangles (no
 // leaks). Barycentrics: hit point = (1 - u - v) v0 + u v1 + v v2, u, v, u + v in [0, 1].
-// Zero-area triangles (det == 0), rays in the triangle's plane and zero directions never hit.
+// Zero-area triangles (cross(v1 - v0, v2 - v0) == 0 exactly, e.g. repeated or exactly collinear
+// vertices; the sheared det alone can round to non-zero for those), rays in the triangle's plane
+// (det == 0) and zero directions never hit.
 // Outputs are written only on a hit; the hit requires tmin <= t <= tmax.
 NB_FN bool nb_intersect_triangle(vec3 org, vec3 dir, vec3 v0, vec3 v1, vec3 v2, float tmin, float tmax,
                                  NB_OUT(float) t, NB_OUT(float) u, NB_OUT(float) v) {
     // Permute so that z is the dominant direction axis; swap x/y to keep the winding when dir.z < 0.
+    vec3 n = cross(v1 - v0, v2 - v0);
+    if (n.x == 0.0f && n.y == 0.0f && n.z == 0.0f) return false;
     vec3 ad = abs(dir);
     int kz = (ad.x > ad.y) ? ((ad.x > ad.z) ? 0 : 2) : ((ad.y > ad.z) ? 1 : 2);
     int kx = (kz == 2) ? 0 : kz + 1;
