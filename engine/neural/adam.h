@@ -1,0 +1,62 @@
+// Adam with tiny-cuda-nn semantics (notes tiny-cuda-nn §C.2, official notes §5): fp32 master weights,
+// fp32 first/second moments and a uint32 step counter PER PARAMETER.
+//   g = grad / loss_scale
+//   grid (non-matrix) params: if g == 0 exactly, the parameter is skipped entirely (no moment decay, no
+//     step increment: a sparse/lazy update of hash entries no sample touched); l2 = non_matrix_l2_reg
+//   MLP (matrix) params: always updated; l2 = l2_reg
+//   g += l2 * w;  m = b1 m + (1-b1) g;  v = b2 v + (1-b2) g^2;  t = ++step[i]
+//   w -= lr * sqrt(1 - b2^t) / (1 - b1^t) / (sqrt(v) + eps) * m
+// (eps is added to sqrt of the UNCORRECTED v, tcnn's folded form; PyTorch differs by sqrt(1-b2^t) on
+// eps.) AdaBound, weight clipping and relative/absolute decay are tcnn options N-BVH leaves off; they
+// are not implemented. The learning rate comes from ExponentialDecay (lr_at_step), N-BVH defaults.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "engine/neural/reference_network.h"
+
+namespace nbvh::neural {
+
+struct AdamConfig {
+    float learning_rate = 1e-2f;
+    float beta1 = 0.9f;
+    float beta2 = 0.999f;
+    float epsilon = 1e-8f;
+    float l2_reg = 1e-8f;          // MLP weights
+    float non_matrix_l2_reg = 0.0f; // grid
+    float loss_scale = 1.0f;        // gradients are divided by this (tcnn fp16 training uses 128)
+    bool skip_zero_grad_non_matrix = true;
+    // ExponentialDecay (tcnn exponential_decay.h): lr(s) = lr * base^(floor((min(s,end)-start)/interval)+1)
+    // for s >= start (s = 0-based index of the step about to be taken), else lr.
+    uint32_t decay_start = 10000;
+    uint32_t decay_interval = 2000;
+    uint32_t decay_end = 10000000;
+    float decay_base = 0.33f;
+};
+
+// Effective learning rate of 0-based step s under the config's ExponentialDecay.
+float lr_at_step(const AdamConfig& cfg, uint64_t step);
+
+class Adam {
+public:
+    Adam(const AdamConfig& cfg, size_t mlp_params, size_t grid_params);
+    // One step on w (fp32 master) with dense gradients of the same sizes as w.mlp / w.grid.
+    void step(NetworkWeights& w, const std::vector<float>& mlp_grad, const std::vector<float>& grid_grad);
+    uint64_t steps_taken() const { return steps_; }
+    const AdamConfig& config() const { return cfg_; }
+    // State, exposed for tests and checkpoints: moments and per-parameter step counters.
+    const std::vector<float>& mlp_m() const { return mlp_m_; }
+    const std::vector<float>& mlp_v() const { return mlp_v_; }
+    const std::vector<uint32_t>& mlp_t() const { return mlp_t_; }
+    const std::vector<float>& grid_m() const { return grid_m_; }
+    const std::vector<float>& grid_v() const { return grid_v_; }
+    const std::vector<uint32_t>& grid_t() const { return grid_t_; }
+
+private:
+    AdamConfig cfg_;
+    uint64_t steps_ = 0;
+    std::vector<float> mlp_m_, mlp_v_, grid_m_, grid_v_;
+    std::vector<uint32_t> mlp_t_, grid_t_;
+};
+
+} // namespace nbvh::neural

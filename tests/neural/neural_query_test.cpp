@@ -1,0 +1,154 @@
+// Segment encoding (entry/middle/exit, reversal), zero-extent guard, extreme scales and decode rules.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "shaders/shared/neural_query.h"
+
+namespace {
+bool finite3(vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+} // namespace
+
+TEST(NeuralQuery, EncodingBoxAndPoint) {
+    const GpuEncodingBox b = nb_make_encoding_box(vec3(-1.0f, 0.0f, 2.0f), vec3(1.0f, 4.0f, 3.0f));
+    EXPECT_FLOAT_EQ(b.center.x, 0.0f);
+    EXPECT_FLOAT_EQ(b.center.y, 2.0f);
+    EXPECT_FLOAT_EQ(b.center.z, 2.5f);
+    EXPECT_FLOAT_EQ(b.extent.x, 2.0f * 1.00011f);
+    EXPECT_FLOAT_EQ(b.extent.y, 4.0f * 1.00011f);
+    EXPECT_FLOAT_EQ(b.extent.z, 1.0f * 1.00011f);
+    EXPECT_FLOAT_EQ(b.depth_pad, 1e-3f);
+    EXPECT_FLOAT_EQ(b.fixed_depth_eps, 1e-5f);
+    // the box corners map just inside [0,1] (anisotropic, per axis)
+    const vec3 lo = nb_encode_point(b, vec3(-1.0f, 0.0f, 2.0f));
+    const vec3 hi = nb_encode_point(b, vec3(1.0f, 4.0f, 3.0f));
+    EXPECT_NEAR(lo.x, 0.5f - 0.5f / 1.00011f, 1e-6f);
+    EXPECT_NEAR(hi.y, 0.5f + 0.5f / 1.00011f, 1e-6f);
+    EXPECT_GT(lo.z, 0.0f);
+    EXPECT_LT(hi.z, 1.0f);
+    const vec3 c = nb_encode_point(b, vec3(0.0f, 2.0f, 2.5f));
+    EXPECT_FLOAT_EQ(c.x, 0.5f);
+    EXPECT_FLOAT_EQ(c.y, 0.5f);
+}
+
+TEST(NeuralQuery, EntryMiddleExitForward) {
+    const GpuEncodingBox b = nb_make_encoding_box(vec3(0.0f), vec3(1.0f));
+    vec3 p0, p1, p2;
+    // ray along +x through the unit box from x = -1: entry t = 1.25, exit t = 1.75 (leaf [0.25,0.75])
+    const bool rev = nb_segment_points(b, vec3(-1.0f, 0.5f, 0.5f), vec3(1.0f, 0.0f, 0.0f), 1.25f, 1.75f, p0, p1, p2);
+    EXPECT_FALSE(rev);
+    const float s = 1.0f / 1.00011f;
+    EXPECT_NEAR(p0.x, 0.5f + (0.25f - 0.5f) * s, 1e-6f);
+    EXPECT_NEAR(p1.x, 0.5f, 1e-6f);
+    EXPECT_NEAR(p2.x, 0.5f + (0.75f - 0.5f) * s, 1e-6f);
+    EXPECT_FLOAT_EQ(p0.y, 0.5f);
+    EXPECT_FLOAT_EQ(p1.z, 0.5f);
+}
+
+TEST(NeuralQuery, OriginInsideLeafReversesSegment) {
+    const GpuEncodingBox b = nb_make_encoding_box(vec3(0.0f), vec3(1.0f));
+    vec3 f0, f1, f2, r0, r1, r2;
+    // origin at x = 0.4 inside leaf [0.2, 0.8] (t_entry = -0.2 < 0): query runs exit -> entry
+    const bool rev = nb_segment_points(b, vec3(0.4f, 0.5f, 0.5f), vec3(1.0f, 0.0f, 0.0f), -0.2f, 0.4f, r0, r1, r2);
+    EXPECT_TRUE(rev);
+    nb_segment_points(b, vec3(0.0f, 0.5f, 0.5f), vec3(1.0f, 0.0f, 0.0f), 0.2f, 0.8f, f0, f1, f2);
+    EXPECT_NEAR(r0.x, f2.x, 1e-6f); // reversed start = forward exit (x = 0.8)
+    EXPECT_NEAR(r2.x, f0.x, 1e-6f);
+    EXPECT_NEAR(r1.x, f1.x, 1e-6f);
+    // origin exactly on the entry face (t_entry = 0) is NOT inside
+    EXPECT_FALSE(nb_query_reversed(0.0f));
+    EXPECT_TRUE(nb_query_reversed(-1e-30f));
+}
+
+TEST(NeuralQuery, DecodeDepthOutsideAndInside) {
+    const GpuEncodingBox b = nb_make_encoding_box(vec3(0.0f), vec3(1.0f));
+    float t = 0.0f;
+    // outside: t = t_entry + u (L + 1e-3)
+    EXPECT_TRUE(nb_decode_depth(b, 0.5f, 2.0f, 4.0f, t));
+    EXPECT_FLOAT_EQ(t, 2.0f + 0.5f * 2.001f);
+    EXPECT_TRUE(nb_decode_depth(b, 1.7f, 2.0f, 4.0f, t)); // u clamped to 1
+    EXPECT_FLOAT_EQ(t, 2.0f + 2.001f);
+    EXPECT_TRUE(nb_decode_depth(b, std::nanf(""), 2.0f, 4.0f, t)); // NaN -> u = 0, no NaN out
+    EXPECT_FLOAT_EQ(t, 2.0f);
+    // inside: t_entry = -1, t_exit = 1, L = 2; d = u * 2.001 measured back from the exit;
+    // accepted iff d < 1 - 0.2 * 2 - 1e-5 = 0.59999
+    EXPECT_TRUE(nb_decode_depth(b, 0.25f, -1.0f, 1.0f, t)); // d = 0.50025
+    EXPECT_FLOAT_EQ(t, 1.0f - 0.25f * 2.001f);
+    EXPECT_FALSE(nb_decode_depth(b, 0.3f, -1.0f, 1.0f, t)); // d = 0.6003 -> too close to the origin
+    EXPECT_FLOAT_EQ(t, 1.0f - 0.3f * 2.001f);
+    // target encoding inverts the decode
+    const float u = nb_encode_depth_target(b, 3.0f, 2.0f, 4.0f, false);
+    EXPECT_TRUE(nb_decode_depth(b, u, 2.0f, 4.0f, t));
+    EXPECT_NEAR(t, 3.0f, 1e-6f);
+    EXPECT_NEAR(nb_encode_depth_target(b, 0.5f, -1.0f, 1.0f, true), 0.5f / 2.001f, 1e-7f);
+}
+
+TEST(NeuralQuery, DecodeVisibilityAndNormal) {
+    EXPECT_TRUE(nb_decode_visibility(0.51f, NB_VISIBILITY_THRESHOLD));
+    EXPECT_FALSE(nb_decode_visibility(0.5f, NB_VISIBILITY_THRESHOLD)); // strictly greater
+    EXPECT_FALSE(nb_decode_visibility(std::nanf(""), NB_VISIBILITY_THRESHOLD));
+    vec3 n = nb_decode_normal(1.0f, 0.5f, 0.5f);
+    EXPECT_FLOAT_EQ(n.x, 1.0f);
+    EXPECT_FLOAT_EQ(n.y, 0.0f);
+    // linearised outputs (0.45..0.55) decode to the same direction: 2y - 1 = n / 10
+    n = nb_decode_normal(0.5f, 0.5f - 0.05f * 0.6f, 0.5f + 0.05f * 0.8f);
+    EXPECT_NEAR(n.y, -0.6f, 1e-4f);
+    EXPECT_NEAR(n.z, 0.8f, 1e-4f);
+    n = nb_decode_normal(0.5f, 0.5f, 0.5f); // degenerate -> +z, not NaN
+    EXPECT_FLOAT_EQ(n.z, 1.0f);
+}
+
+TEST(NeuralQuery, ZeroExtentAssetsAreGuarded) {
+    // flat asset (zero extent in y), a line (zero in y and z), a point (all zero)
+    const vec3 los[3] = {vec3(0.0f, 1.0f, 0.0f), vec3(0.0f, 1.0f, 1.0f), vec3(3.0f, 1.0f, 1.0f)};
+    const vec3 his[3] = {vec3(2.0f, 1.0f, 2.0f), vec3(2.0f, 1.0f, 1.0f), vec3(3.0f, 1.0f, 1.0f)};
+    for (int i = 0; i < 3; ++i) {
+        const GpuEncodingBox b = nb_make_encoding_box(los[i], his[i]);
+        EXPECT_GT(b.extent.x, 0.0f);
+        EXPECT_GT(b.extent.y, 0.0f);
+        EXPECT_GT(b.extent.z, 0.0f);
+        // the guard: at least 1e-3 of the largest extent
+        if (i < 2) {
+            EXPECT_GE(b.extent.y, 2.0f * 1e-3f);
+        }
+        const vec3 e = nb_encode_point(b, vec3(1.0f, 1.0f, 1.0f));
+        EXPECT_TRUE(finite3(e));
+        vec3 p0, p1, p2;
+        nb_segment_points(b, vec3(1.0f, 5.0f, 1.0f), vec3(0.0f, -1.0f, 0.0f), 4.0f, 4.0f, p0, p1, p2);
+        EXPECT_TRUE(finite3(p0) && finite3(p1) && finite3(p2));
+        EXPECT_NEAR(p1.y, 0.5f, 1e-5f); // the flat plane is the centre of the padded axis
+    }
+}
+
+TEST(NeuralQuery, ExtremeScalesAndBadIntervalsGiveFiniteInputs) {
+    const float inf = std::numeric_limits<float>::infinity();
+    struct Case { vec3 lo, hi; };
+    const Case cases[] = {
+        {vec3(0.0f), vec3(1e-3f)},                                      // tiny asset
+        {vec3(-1e5f), vec3(1e5f)},                                      // huge asset
+        {vec3(1e5f, 1e5f, 1e5f), vec3(1e5f + 1.0f, 1e5f, 1e5f + 1.0f)}, // far and flat
+        {vec3(-3e7f), vec3(-3e7f + 1e-3f)},                             // far and tiny
+    };
+    for (const Case& c : cases) {
+        const GpuEncodingBox b = nb_make_encoding_box(c.lo, c.hi);
+        EXPECT_TRUE(finite3(b.extent) && finite3(b.center));
+        const vec3 mid = (c.lo + c.hi) * 0.5f;
+        const vec3 dirs[3] = {vec3(1.0f, 0.0f, 0.0f), vec3(0.0f, 0.0f, -1.0f), vec3(0.57735f)};
+        // intervals a traversal may hand over: normal, empty, origin on a face, parallel (+-inf), NaN
+        const float ts[][2] = {{0.0f, 1e-3f}, {-1e-3f, 1e-3f}, {0.0f, 0.0f}, {-inf, inf}, {std::nanf(""), 1.0f}};
+        for (const vec3& d : dirs)
+            for (const auto& t : ts) {
+                vec3 p0, p1, p2;
+                nb_segment_points(b, mid, d, t[0], t[1], p0, p1, p2);
+                EXPECT_TRUE(finite3(p0) && finite3(p1) && finite3(p2));
+                EXPECT_GE(p0.x, NB_ENC_CLAMP_LO);
+                EXPECT_LE(p2.z, NB_ENC_CLAMP_HI);
+                float th = 0.0f;
+                nb_decode_depth(b, 0.5f, t[0], t[1], th);
+                if (std::isfinite(t[0]) && std::isfinite(t[1])) {
+                    EXPECT_TRUE(std::isfinite(th));
+                }
+            }
+    }
+}
