@@ -1,0 +1,46 @@
+// Packs a Scene and its SceneAccel into the flat arrays the wavefront shaders read
+// (shaders/shared/scene_gpu.h). Pure CPU, so it is unit-tested without a device; GpuSceneBuffers
+// (wavefront.h) uploads the result.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "engine/bvh/scene_accel.h"
+#include "engine/render/environment_sampler.h"
+#include "engine/scene/scene.h"
+#include "shaders/shared/bvh_node.h"
+#include "shaders/shared/scene_gpu.h"
+
+namespace nbvh::render {
+
+struct GpuSceneData {
+    std::vector<GpuBvhNode> tlas_nodes;   // leaf refs index `instances`
+    std::vector<GpuBvhNode> blas_nodes;   // all BLASes; interior refs already offset to this array
+    std::vector<GpuInstance> instances;   // TLAS leaf order
+    std::vector<GpuTriangle> triangles;   // per mesh in BLAS leaf order, concatenated
+    std::vector<GpuVertex> vertices;      // all meshes' vertices, concatenated
+    std::vector<GpuMaterial> materials;
+    std::vector<GpuTextureInfo> texture_infos;
+    std::vector<uint32_t> texels;         // RGBA8
+    std::vector<GpuLight> lights;         // emissive triangles, world space
+    std::vector<float> light_cdf;         // light_count + 1 entries
+    float light_total_power = 0.0f;
+    EnvironmentTable environment;
+
+    // For mapping GPU results back to the scene (tests, debugging).
+    std::vector<uint32_t> instance_to_scene;   // GPU instance -> Scene::instances index
+    std::vector<uint32_t> triangle_to_mesh_triangle; // GPU triangle -> original triangle id in its mesh
+    float scene_extent = 1.0f;                  // world bounds diagonal (m)
+    uint32_t texture_downscales = 0;            // halvings applied to fit the texel budget
+};
+
+struct PackOptions {
+    bool textures = true;                       // false: no texel upload (scene has no texture feature)
+    uint64_t texel_budget_bytes = 96ull << 20;  // below lavapipe's 128 MiB per binding
+};
+
+// `environment` is the one the render uses (scene's, --env, or the default sky).
+GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Environment& environment,
+                        const PackOptions& options = {});
+
+} // namespace nbvh::render

@@ -1,1 +1,0 @@
-// render: sources land here

@@ -1,0 +1,288 @@
+#include "engine/render/wavefront.h"
+
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "engine/core/error.h"
+#include "engine/core/log.h"
+#include "engine/scene/camera.h"
+#include "shaders/shared/wavefront_gpu.h"
+
+namespace nbvh::render {
+
+namespace {
+
+enum Pass : size_t { CAMERA, QUEUE_ARGS, TRAVERSE, SHADE, SHADOW, ACCUMULATE, RESOLVE, PASS_COUNT };
+const char* const PASS_SHADERS[PASS_COUNT] = {"passes/camera_rays.comp", "passes/queue_args.comp",
+                                              "passes/traverse.comp",    "passes/shade.comp",
+                                              "passes/shadow.comp",      "passes/accumulate.comp",
+                                              "passes/resolve.comp"};
+
+template <class T> vk::Buffer upload(const vk::Context& ctx, const std::vector<T>& items, const char* name) {
+    return vk::make_buffer(ctx, items, name);
+}
+
+} // namespace
+
+WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene, const SceneAccel& accel,
+                                     const Environment& environment, const Camera& camera,
+                                     const RenderOptions& options)
+    : ctx_(ctx), options_(options) {
+    if (options_.width == 0 || options_.height == 0 || options_.width > 16384 || options_.height > 16384)
+        throw Error(strfmt("image size %ux%u is out of range (1..16384 per side)", options_.width, options_.height));
+    if (options_.spp == 0) throw Error("--spp must be at least 1");
+    if (options_.max_depth == 0 || options_.max_depth > 256) throw Error("--max-depth must be in 1..256");
+    const vk::DeviceFeatures& dev = ctx_.features();
+    if (!dev.scalar_layout) throw Error("the Vulkan device lacks scalarBlockLayout, which every pass needs");
+    const uint64_t pixels = uint64_t(options_.width) * options_.height;
+    const uint64_t range = dev.max_storage_buffer_range ? dev.max_storage_buffer_range : (128ull << 20);
+    if (pixels * sizeof(vec4) > range)
+        throw Error(strfmt("image of %llu pixels exceeds the device's storage-buffer range (%llu MiB)",
+                           (unsigned long long)pixels, (unsigned long long)(range >> 20)));
+    uint64_t cap = std::min<uint64_t>(pixels, std::max<uint32_t>(options_.max_wave_pixels, 64));
+    cap = std::min<uint64_t>(cap, range / (2ull * NB_RAY_WORDS * 4ull));
+    capacity_ = uint32_t(cap);
+
+    features_ = derive_features(scene, environment);
+    PackOptions pack;
+    pack.textures = features_.textures;
+    data_ = pack_scene(scene, accel, environment, pack);
+    if (features_.emission && data_.lights.size() == 1 && data_.light_total_power <= 0.0f) features_.emission = false;
+
+    // Per-render parameters.
+    const CameraBasis basis = camera_basis(camera);
+    GpuFrameParams& p = params_;
+    p.cam_eye = camera.eye;
+    p.cam_tan_half_fov = std::tan(0.5f * std::clamp(camera.yfov, 1.0e-3f, 3.1f));
+    p.cam_forward = basis.forward;
+    p.aspect = float(options_.width) / float(options_.height);
+    p.cam_right = basis.right;
+    p.width = options_.width;
+    p.cam_up = basis.up;
+    p.height = options_.height;
+    p.env_width = data_.environment.width;
+    p.env_height = data_.environment.height;
+    p.env_intensity = data_.environment.intensity;
+    p.env_rotation = data_.environment.rotation;
+    p.env_inv_mean = data_.environment.inv_mean;
+    p.light_count = data_.light_total_power > 0.0f ? uint32_t(data_.lights.size()) : 0u;
+    p.light_total_power = data_.light_total_power;
+    p.max_depth = options_.max_depth;
+    p.rr_start_depth = options_.rr_start_depth;
+    p.seed = options_.seed;
+    p.spp = options_.spp;
+    p.wave_capacity = capacity_;
+    p.ray_epsilon = 1.0e-5f * data_.scene_extent;
+    p.instance_count = accel.tlas.prim_indices.empty() ? 0u : uint32_t(data_.instances.size());
+
+    // Buffers, indexed by binding.
+    buffers_.resize(NB_BINDING_COUNT);
+    buffers_[NB_BIND_PARAMS] = upload(ctx_, std::vector<GpuFrameParams>{params_}, "params");
+    buffers_[NB_BIND_COUNTERS] = vk::Buffer(ctx_, sizeof(GpuQueueCounters), vk::MemoryKind::device,
+                                            VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, "queue counters");
+    buffers_[NB_BIND_TLAS_NODES] = upload(ctx_, data_.tlas_nodes, "tlas nodes");
+    buffers_[NB_BIND_BLAS_NODES] = upload(ctx_, data_.blas_nodes, "blas nodes");
+    buffers_[NB_BIND_INSTANCES] = upload(ctx_, data_.instances, "instances");
+    buffers_[NB_BIND_TRIANGLES] = upload(ctx_, data_.triangles, "triangles");
+    buffers_[NB_BIND_VERTICES] = upload(ctx_, data_.vertices, "vertices");
+    buffers_[NB_BIND_MATERIALS] = upload(ctx_, data_.materials, "materials");
+    buffers_[NB_BIND_TEXTURE_INFOS] = upload(ctx_, data_.texture_infos, "texture infos");
+    buffers_[NB_BIND_TEXELS] = upload(ctx_, data_.texels, "texels");
+    buffers_[NB_BIND_LIGHTS] = upload(ctx_, data_.lights, "lights");
+    buffers_[NB_BIND_LIGHT_CDF] = upload(ctx_, data_.light_cdf, "light cdf");
+    buffers_[NB_BIND_ENV] = upload(ctx_, data_.environment.data, "environment");
+    buffers_[NB_BIND_RAYS] = vk::Buffer(ctx_, uint64_t(capacity_) * 2 * NB_RAY_WORDS * 4, vk::MemoryKind::device, 0, "rays");
+    buffers_[NB_BIND_HITS] = vk::Buffer(ctx_, uint64_t(capacity_) * NB_HIT_WORDS * 4, vk::MemoryKind::device, 0, "hits");
+    buffers_[NB_BIND_SHADOW_RAYS] =
+        vk::Buffer(ctx_, uint64_t(capacity_) * NB_SHADOW_WORDS * 4, vk::MemoryKind::device, 0, "shadow rays");
+    buffers_[NB_BIND_SAMPLE_RADIANCE] =
+        vk::Buffer(ctx_, uint64_t(capacity_) * sizeof(vec3), vk::MemoryKind::device, 0, "sample radiance");
+    buffers_[NB_BIND_FILM] = vk::Buffer(ctx_, pixels * sizeof(vec4), vk::MemoryKind::device, 0, "film");
+    // Neural issue: sized by the pending-leaf capacity; a placeholder until neural instances exist.
+    buffers_[NB_BIND_PENDING_LEAVES] =
+        vk::Buffer(ctx_, sizeof(GpuPendingLeaf), vk::MemoryKind::device, 0, "pending leaves");
+    buffers_[NB_BIND_OUTPUT] = vk::Buffer(ctx_, pixels * sizeof(vec4), vk::MemoryKind::device, 0, "output");
+    for (uint32_t b : {NB_BIND_COUNTERS, NB_BIND_RAYS, NB_BIND_HITS, NB_BIND_SHADOW_RAYS, NB_BIND_SAMPLE_RADIANCE,
+                       NB_BIND_FILM, NB_BIND_PENDING_LEAVES, NB_BIND_OUTPUT})
+        buffers_[b].fill(0u);
+
+    // One pipeline per pass, all with the same set-0 layout and the scene's specialization.
+    std::vector<vk::Binding> bindings;
+    for (uint32_t b = 0; b < NB_BINDING_COUNT; ++b) bindings.push_back({b, vk::BindingType::storage_buffer, 1});
+    const std::vector<vk::SpecConstant> spec = specialization(features_);
+    for (size_t i = 0; i < PASS_COUNT; ++i) {
+        if (i == SHADOW && !features_.has_lights()) {
+            pipelines_.emplace_back();
+            sets_.emplace_back();
+            continue; // no shadow pass without anything to sample
+        }
+        vk::PipelineDesc desc;
+        desc.shader = PASS_SHADERS[i];
+        desc.bindings = bindings;
+        desc.spec = spec;
+        desc.push_constant_bytes = sizeof(GpuPassConstants);
+        pipelines_.emplace_back(ctx_, desc);
+        vk::DescriptorSet set(ctx_, pipelines_.back());
+        for (uint32_t b = 0; b < NB_BINDING_COUNT; ++b) set.bind(b, buffers_[b]);
+        sets_.push_back(std::move(set));
+    }
+    timer_ = vk::GpuTimer(ctx_, 64 + 8 * options_.max_depth);
+    cmd_ = vk::CommandBuffer(ctx_, "wavefront");
+}
+
+GpuPassConstants WavefrontRenderer::constants(uint32_t queue, uint32_t depth, uint32_t sample, uint32_t offset,
+                                              uint32_t count, uint32_t mode) const {
+    GpuPassConstants pc{};
+    pc.in_queue = queue;
+    pc.depth = depth;
+    pc.sample_index = sample;
+    pc.pixel_offset = offset;
+    pc.pixel_count = count;
+    pc.mode = mode;
+    return pc;
+}
+
+void WavefrontRenderer::record_pass(vk::CommandBuffer& cmd, size_t pass, const GpuPassConstants& pc,
+                                    Dispatch dispatch, uint64_t items) {
+    cmd.begin_pass(PASS_SHADERS[pass], timer_.available() ? &timer_ : nullptr);
+    cmd.bind(pipelines_[pass], sets_[pass]).push(pc);
+    switch (dispatch) {
+    case Dispatch::items: cmd.dispatch_items(items, NB_WAVEFRONT_GROUP); break;
+    case Dispatch::single: cmd.dispatch(1); break;
+    case Dispatch::indirect_rays: cmd.dispatch_indirect(buffers_[NB_BIND_COUNTERS], NB_COUNTERS_RAY_DISPATCH_OFFSET); break;
+    case Dispatch::indirect_shadow:
+        cmd.dispatch_indirect(buffers_[NB_BIND_COUNTERS], NB_COUNTERS_SHADOW_DISPATCH_OFFSET);
+        break;
+    }
+    cmd.end_pass();
+    // queue_args writes dispatch arguments; everything else feeds the next pass's shader reads.
+    cmd.barrier(pass == QUEUE_ARGS ? vk::Barrier::compute_to_indirect : vk::Barrier::compute_to_compute);
+}
+
+void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, uint32_t sample, uint32_t offset, uint32_t count) {
+    record_pass(cmd, CAMERA, constants(0, 0, sample, offset, count, 0), Dispatch::items, count);
+    uint32_t q = 0;
+    for (uint32_t depth = 0; depth < options_.max_depth; ++depth) {
+        record_pass(cmd, QUEUE_ARGS, constants(q, depth, sample, offset, count, NB_ARGS_MODE_RAYS), Dispatch::single);
+        record_pass(cmd, TRAVERSE, constants(q, depth, sample, offset, count, 0), Dispatch::indirect_rays);
+        record_pass(cmd, SHADE, constants(q, depth, sample, offset, count, 0), Dispatch::indirect_rays);
+        if (features_.has_lights()) {
+            record_pass(cmd, QUEUE_ARGS, constants(q, depth, sample, offset, count, NB_ARGS_MODE_SHADOW),
+                        Dispatch::single);
+            record_pass(cmd, SHADOW, constants(q, depth, sample, offset, count, 0), Dispatch::indirect_shadow);
+        }
+        q = 1 - q;
+    }
+    record_pass(cmd, ACCUMULATE, constants(0, 0, sample, offset, count, 0), Dispatch::items, count);
+}
+
+RenderResult WavefrontRenderer::render() {
+    const auto t0 = std::chrono::steady_clock::now();
+    const uint32_t pixels = options_.width * options_.height;
+    buffers_[NB_BIND_FILM].fill(0u);
+    buffers_[NB_BIND_COUNTERS].fill(0u);
+
+    std::vector<std::pair<std::string, double>> pass_ms;
+    std::map<std::string, size_t> pass_index;
+    auto collect = [&] {
+        if (!timer_.available()) return;
+        for (const auto& [name, ms] : timer_.results()) {
+            auto it = pass_index.find(name);
+            if (it == pass_index.end()) {
+                pass_index[name] = pass_ms.size();
+                pass_ms.emplace_back(name, ms);
+            } else {
+                pass_ms[it->second].second += ms;
+            }
+        }
+    };
+    // One submission per (sample, wave): bounded command buffers and timer slots at any spp.
+    for (uint32_t sample = 0; sample < options_.spp; ++sample) {
+        for (uint32_t offset = 0; offset < pixels; offset += capacity_) {
+            const uint32_t count = std::min(capacity_, pixels - offset);
+            cmd_.begin();
+            if (timer_.available()) timer_.reset(cmd_.handle());
+            record_sample_wave(cmd_, sample, offset, count);
+            cmd_.submit_and_wait();
+            collect();
+        }
+    }
+    cmd_.begin();
+    if (timer_.available()) timer_.reset(cmd_.handle());
+    record_pass(cmd_, RESOLVE, constants(0, 0, 0, 0, pixels, 0), Dispatch::items, pixels);
+    cmd_.barrier(vk::Barrier::compute_to_transfer);
+    cmd_.submit_and_wait();
+    collect();
+
+    RenderResult result;
+    result.image = Image(int(options_.width), int(options_.height), 4);
+    buffers_[NB_BIND_OUTPUT].download(result.image.data.data(), uint64_t(pixels) * sizeof(vec4));
+    const GpuQueueCounters counters = buffers_[NB_BIND_COUNTERS].download<GpuQueueCounters>(1)[0];
+
+    RenderStats& s = result.stats;
+    s.device = ctx_.features().device_name;
+    s.driver = ctx_.features().driver_name + " " + ctx_.features().driver_info;
+    s.width = options_.width;
+    s.height = options_.height;
+    s.spp = options_.spp;
+    s.max_depth = options_.max_depth;
+    s.pass_ms = pass_ms;
+    for (const auto& [name, ms] : pass_ms) s.gpu_ms += ms;
+    s.rays_primary = counters.rays_primary;
+    s.rays_secondary = counters.rays_secondary;
+    s.rays_shadow = counters.rays_shadow;
+    s.nonfinite_samples = counters.nonfinite_samples;
+    for (size_t i = 0; i < result.image.pixel_count(); ++i) {
+        const float* px = result.image.data.data() + i * 4;
+        if (!std::isfinite(px[0]) || !std::isfinite(px[1]) || !std::isfinite(px[2])) ++s.nonfinite_pixels;
+    }
+    s.wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return result;
+}
+
+std::vector<TraceHit> WavefrontRenderer::trace(const std::vector<glm::vec3>& origins, const std::vector<glm::vec3>& dirs,
+                                               float tmin) {
+    NBVH_CHECK(origins.size() == dirs.size());
+    std::vector<TraceHit> out;
+    out.reserve(origins.size());
+    for (size_t first = 0; first < origins.size(); first += capacity_) {
+        const uint32_t n = uint32_t(std::min<size_t>(capacity_, origins.size() - first));
+        // Queue 0 in SOA layout (wavefront_gpu.h); unused fields stay zero.
+        std::vector<uint32_t> words(size_t(capacity_) * NB_RAY_WORDS, 0u);
+        for (uint32_t i = 0; i < n; ++i) {
+            for (uint32_t c = 0; c < 3; ++c) {
+                words[nb_ray_word(0, NB_RAY_ORIGIN, capacity_, i, 3) + c] = floatBitsToUint(origins[first + i][c]);
+                words[nb_ray_word(0, NB_RAY_DIR, capacity_, i, 3) + c] = floatBitsToUint(dirs[first + i][c]);
+            }
+            words[nb_ray_word(0, NB_RAY_T_RESUME, capacity_, i, 1)] = floatBitsToUint(tmin);
+        }
+        buffers_[NB_BIND_RAYS].upload(words);
+        GpuQueueCounters counters{};
+        counters.ray_count0 = n;
+        buffers_[NB_BIND_COUNTERS].upload(&counters, sizeof(counters));
+        cmd_.begin();
+        if (timer_.available()) timer_.reset(cmd_.handle());
+        record_pass(cmd_, QUEUE_ARGS, constants(0, 0, 0, 0, n, NB_ARGS_MODE_RAYS), Dispatch::single);
+        record_pass(cmd_, TRAVERSE, constants(0, 0, 0, 0, n, 0), Dispatch::indirect_rays);
+        cmd_.barrier(vk::Barrier::compute_to_transfer);
+        cmd_.submit_and_wait();
+        const std::vector<uint32_t> hits = buffers_[NB_BIND_HITS].download<uint32_t>(size_t(capacity_) * NB_HIT_WORDS);
+        for (uint32_t i = 0; i < n; ++i) {
+            TraceHit h;
+            const uint32_t inst = hits[nb_hit_word(NB_HIT_INSTANCE, capacity_, i, 1)];
+            if (inst != NB_NO_HIT && inst < data_.instance_to_scene.size()) {
+                h.t = uintBitsToFloat(hits[nb_hit_word(NB_HIT_T, capacity_, i, 1)]);
+                h.instance = data_.instance_to_scene[inst];
+                const uint32_t tri = hits[nb_hit_word(NB_HIT_TRIANGLE, capacity_, i, 1)];
+                h.triangle = tri < data_.triangle_to_mesh_triangle.size() ? data_.triangle_to_mesh_triangle[tri] : tri;
+                h.u = uintBitsToFloat(hits[nb_hit_word(NB_HIT_BARY, capacity_, i, 2)]);
+                h.v = uintBitsToFloat(hits[nb_hit_word(NB_HIT_BARY, capacity_, i, 2) + 1]);
+            }
+            out.push_back(h);
+        }
+    }
+    return out;
+}
+
+} // namespace nbvh::render

@@ -1,0 +1,97 @@
+// The wavefront path tracer: owns the scene buffers, the per-ray SOA queues and one compute pipeline
+// per stage, and records the pass sequence (README.md here):
+//   camera_rays -> [queue_args -> traverse -> shade -> (queue_args -> shadow)] x max_depth -> accumulate
+//   ... per sample and wave of pixels, then resolve once.
+// The Vulkan context owns device things; the Scene/SceneAccel stay with the caller.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "engine/bvh/scene_accel.h"
+#include "engine/core/image.h"
+#include "engine/render/feature_set.h"
+#include "engine/render/gpu_scene.h"
+#include "shaders/shared/wavefront_gpu.h"
+#include "engine/scene/scene.h"
+#include "engine/vk/buffer.h"
+#include "engine/vk/commands.h"
+#include "engine/vk/context.h"
+#include "engine/vk/pipeline.h"
+
+namespace nbvh::render {
+
+struct RenderOptions {
+    uint32_t width = 640, height = 480;
+    uint32_t spp = 16;
+    uint32_t max_depth = 8;          // path segments (1: emitters and environment seen directly)
+    uint32_t seed = 0;
+    uint32_t rr_start_depth = 3;     // Russian roulette from this segment on
+    uint32_t max_wave_pixels = 1u << 20; // rays per queue; bounded by the device's storage range too
+};
+
+struct RenderStats {
+    std::string device, driver;
+    uint32_t width = 0, height = 0, spp = 0, max_depth = 0;
+    std::vector<std::pair<std::string, double>> pass_ms; // summed GPU time per pass (timestamps)
+    double gpu_ms = 0.0;           // sum of the passes
+    double wall_ms = 0.0;          // host time of render(), submissions included
+    uint64_t rays_primary = 0, rays_secondary = 0, rays_shadow = 0;
+    uint64_t nonfinite_samples = 0; // dropped by accumulate.comp
+    uint64_t nonfinite_pixels = 0;  // in the resolved image (counted on the CPU; must be 0)
+    uint64_t rays_total() const { return rays_primary + rays_secondary + rays_shadow; }
+    double rays_per_second() const { return gpu_ms > 0.0 ? double(rays_total()) / (gpu_ms * 1.0e-3) : 0.0; }
+};
+
+struct RenderResult {
+    Image image; // linear RGBA float, alpha 1
+    RenderStats stats;
+};
+
+// A closest hit from the GPU traversal, in scene terms (for tests against the CPU traversal).
+struct TraceHit {
+    float t = NB_INF;
+    uint32_t instance = 0xFFFFFFFFu; // Scene::instances index; 0xFFFFFFFF: miss
+    uint32_t triangle = 0xFFFFFFFFu; // original triangle index in the instance's mesh
+    float u = 0.0f, v = 0.0f;
+};
+
+class WavefrontRenderer {
+public:
+    // `environment` is the one to light with (scene's, --env, or default_sky()); `camera` the view.
+    WavefrontRenderer(const vk::Context& ctx, const Scene& scene, const SceneAccel& accel, const Environment& environment,
+                      const Camera& camera, const RenderOptions& options);
+
+    const SceneFeatures& features() const { return features_; }
+    const GpuSceneData& scene_data() const { return data_; }
+
+    // Renders options.spp samples per pixel and reads the mean radiance back.
+    RenderResult render();
+
+    // Closest hits of world-space rays (org, dir; t in [tmin, inf)) through passes/traverse.comp.
+    std::vector<TraceHit> trace(const std::vector<glm::vec3>& origins, const std::vector<glm::vec3>& dirs, float tmin = 0.0f);
+
+private:
+    GpuPassConstants constants(uint32_t queue, uint32_t depth, uint32_t sample, uint32_t offset, uint32_t count,
+                               uint32_t mode) const;
+    enum class Dispatch { items, single, indirect_rays, indirect_shadow };
+    void record_pass(vk::CommandBuffer& cmd, size_t pass, const GpuPassConstants& pc, Dispatch dispatch,
+                     uint64_t items = 0);
+    void record_sample_wave(vk::CommandBuffer& cmd, uint32_t sample, uint32_t offset, uint32_t count);
+
+    const vk::Context& ctx_;
+    RenderOptions options_;
+    SceneFeatures features_;
+    GpuSceneData data_;
+    GpuFrameParams params_{};
+    uint32_t capacity_ = 0;
+
+    std::vector<vk::Buffer> buffers_;          // indexed by NB_BIND_*
+    std::vector<vk::ComputePipeline> pipelines_; // indexed by Pass
+    std::vector<vk::DescriptorSet> sets_;
+    vk::GpuTimer timer_;
+    vk::CommandBuffer cmd_;
+};
+
+} // namespace nbvh::render

@@ -1,0 +1,100 @@
+// Descriptor set 0 of every wavefront pass (binding indices: shared/scene_gpu.h), the scene feature
+// specialization constants and the per-pass push constants. Included first by every pass.
+#ifndef NB_BINDINGS_GLSL
+#define NB_BINDINGS_GLSL
+#extension GL_EXT_scalar_block_layout : require
+
+#include "shared/compat.h"
+#include "shared/bvh_node.h"
+#include "shared/scene_gpu.h"
+#include "shared/wavefront_gpu.h"
+
+// Scene features (engine/render/feature_set.h). Disabled features are compiled out of the pipelines
+// by the driver, so a scene without textures never fetches a texel.
+layout(constant_id = NB_SC_TEXTURES) const bool NB_HAS_TEXTURES = false;
+layout(constant_id = NB_SC_NORMAL_MAPS) const bool NB_HAS_NORMAL_MAPS = false;
+layout(constant_id = NB_SC_EMISSION) const bool NB_HAS_EMISSION = false;
+layout(constant_id = NB_SC_ENVIRONMENT) const bool NB_HAS_ENVIRONMENT = false;
+layout(constant_id = NB_SC_ALPHA_MASK) const bool NB_HAS_ALPHA_MASK = false;
+layout(constant_id = NB_SC_TRANSMISSION) const bool NB_HAS_TRANSMISSION = false;
+layout(constant_id = NB_SC_NEURAL) const bool NB_HAS_NEURAL = false;
+
+layout(push_constant, scalar) uniform PassConstantsBlock { GpuPassConstants pc; };
+
+layout(set = 0, binding = NB_BIND_PARAMS, scalar) readonly buffer ParamsBuffer { GpuFrameParams params; };
+layout(set = 0, binding = NB_BIND_COUNTERS, scalar) coherent buffer CountersBuffer { GpuQueueCounters counters; };
+layout(set = 0, binding = NB_BIND_TLAS_NODES, scalar) readonly buffer TlasBuffer { GpuBvhNode tlas_nodes[]; };
+layout(set = 0, binding = NB_BIND_BLAS_NODES, scalar) readonly buffer BlasBuffer { GpuBvhNode blas_nodes[]; };
+layout(set = 0, binding = NB_BIND_INSTANCES, scalar) readonly buffer InstanceBuffer { GpuInstance instances[]; };
+layout(set = 0, binding = NB_BIND_TRIANGLES, scalar) readonly buffer TriangleBuffer { GpuTriangle triangles[]; };
+layout(set = 0, binding = NB_BIND_VERTICES, scalar) readonly buffer VertexBuffer { GpuVertex vertices[]; };
+layout(set = 0, binding = NB_BIND_MATERIALS, scalar) readonly buffer MaterialBuffer { GpuMaterial materials[]; };
+layout(set = 0, binding = NB_BIND_TEXTURE_INFOS, scalar) readonly buffer TextureInfoBuffer { GpuTextureInfo texture_infos[]; };
+layout(set = 0, binding = NB_BIND_TEXELS, scalar) readonly buffer TexelBuffer { uint texels[]; };
+layout(set = 0, binding = NB_BIND_LIGHTS, scalar) readonly buffer LightBuffer { GpuLight lights[]; };
+layout(set = 0, binding = NB_BIND_LIGHT_CDF, scalar) readonly buffer LightCdfBuffer { float light_cdf[]; };
+// Environment: rgb texels (width*height*3), then the marginal row cdf (height+1), then one conditional
+// cdf per row (height*(width+1)); layout written by engine/render/environment_sampler.cpp.
+layout(set = 0, binding = NB_BIND_ENV, scalar) readonly buffer EnvBuffer { float env_data[]; };
+layout(set = 0, binding = NB_BIND_RAYS, scalar) buffer RayBuffer { uint ray_words[]; };
+layout(set = 0, binding = NB_BIND_HITS, scalar) buffer HitBuffer { uint hit_words[]; };
+layout(set = 0, binding = NB_BIND_SHADOW_RAYS, scalar) buffer ShadowBuffer { uint shadow_words[]; };
+// Radiance of the current sample of each pixel of the wave (index = pixel - pc.pixel_offset).
+layout(set = 0, binding = NB_BIND_SAMPLE_RADIANCE, scalar) buffer SampleRadianceBuffer { vec3 sample_radiance[]; };
+// Running sum over samples, per image pixel (rgb sum, a = samples accumulated).
+layout(set = 0, binding = NB_BIND_FILM, scalar) buffer FilmBuffer { vec4 film[]; };
+layout(set = 0, binding = NB_BIND_PENDING_LEAVES, scalar) buffer PendingLeafBuffer { GpuPendingLeaf pending_leaves[]; };
+layout(set = 0, binding = NB_BIND_OUTPUT, scalar) buffer OutputBuffer { vec4 output_pixels[]; };
+
+// ---- SOA accessors (layout: shared/wavefront_gpu.h) ----------------------------------------------
+uint ray_capacity() { return params.wave_capacity; }
+
+vec3 ray_load3(uint queue, uint field, uint i) {
+    uint w = nb_ray_word(queue, field, ray_capacity(), i, 3u);
+    return vec3(uintBitsToFloat(ray_words[w]), uintBitsToFloat(ray_words[w + 1u]), uintBitsToFloat(ray_words[w + 2u]));
+}
+void ray_store3(uint queue, uint field, uint i, vec3 v) {
+    uint w = nb_ray_word(queue, field, ray_capacity(), i, 3u);
+    ray_words[w] = floatBitsToUint(v.x);
+    ray_words[w + 1u] = floatBitsToUint(v.y);
+    ray_words[w + 2u] = floatBitsToUint(v.z);
+}
+uint ray_load1(uint queue, uint field, uint i) { return ray_words[nb_ray_word(queue, field, ray_capacity(), i, 1u)]; }
+void ray_store1(uint queue, uint field, uint i, uint v) { ray_words[nb_ray_word(queue, field, ray_capacity(), i, 1u)] = v; }
+
+uint hit_load1(uint field, uint i) { return hit_words[nb_hit_word(field, ray_capacity(), i, 1u)]; }
+void hit_store1(uint field, uint i, uint v) { hit_words[nb_hit_word(field, ray_capacity(), i, 1u)] = v; }
+vec2 hit_load_bary(uint i) {
+    uint w = nb_hit_word(NB_HIT_BARY, ray_capacity(), i, 2u);
+    return vec2(uintBitsToFloat(hit_words[w]), uintBitsToFloat(hit_words[w + 1u]));
+}
+void hit_store_bary(uint i, vec2 b) {
+    uint w = nb_hit_word(NB_HIT_BARY, ray_capacity(), i, 2u);
+    hit_words[w] = floatBitsToUint(b.x);
+    hit_words[w + 1u] = floatBitsToUint(b.y);
+}
+
+vec3 shadow_load3(uint field, uint i) {
+    uint w = nb_shadow_word(field, ray_capacity(), i, 3u);
+    return vec3(uintBitsToFloat(shadow_words[w]), uintBitsToFloat(shadow_words[w + 1u]), uintBitsToFloat(shadow_words[w + 2u]));
+}
+void shadow_store3(uint field, uint i, vec3 v) {
+    uint w = nb_shadow_word(field, ray_capacity(), i, 3u);
+    shadow_words[w] = floatBitsToUint(v.x);
+    shadow_words[w + 1u] = floatBitsToUint(v.y);
+    shadow_words[w + 2u] = floatBitsToUint(v.z);
+}
+uint shadow_load1(uint field, uint i) { return shadow_words[nb_shadow_word(field, ray_capacity(), i, 1u)]; }
+void shadow_store1(uint field, uint i, uint v) { shadow_words[nb_shadow_word(field, ray_capacity(), i, 1u)] = v; }
+
+uint queue_count(uint queue) { return queue == 0u ? counters.ray_count0 : counters.ray_count1; }
+
+// Affine transforms stored as three rows.
+vec3 nb_xform_point(vec4 rows[3], vec3 p) {
+    return vec3(dot(rows[0].xyz, p) + rows[0].w, dot(rows[1].xyz, p) + rows[1].w, dot(rows[2].xyz, p) + rows[2].w);
+}
+vec3 nb_xform_vector(vec4 rows[3], vec3 v) { return vec3(dot(rows[0].xyz, v), dot(rows[1].xyz, v), dot(rows[2].xyz, v)); }
+// Normals transform with the inverse transpose: n_world = transpose(M^-1) n = columns of world_to_object.
+vec3 nb_xform_normal(vec4 w2o[3], vec3 n) { return w2o[0].xyz * n.x + w2o[1].xyz * n.y + w2o[2].xyz * n.z; }
+
+#endif

@@ -1,0 +1,61 @@
+// Texture fetches from the RGBA8 texel buffer (layout: GpuTextureInfo in shared/scene_gpu.h):
+// bilinear filtering, repeat wrapping, texel centres at half-integers, v = 0 at the top row (glTF).
+#ifndef NB_TEXTURES_GLSL
+#define NB_TEXTURES_GLSL
+#include "lib/bindings.glsl"
+#include "shared/sampling.h"
+
+vec4 nb_texel(GpuTextureInfo ti, int x, int y) {
+    int w = int(ti.width);
+    int h = int(ti.height);
+    x = ((x % w) + w) % w;
+    y = ((y % h) + h) % h;
+    return unpackUnorm4x8(texels[ti.offset + uint(y) * ti.width + uint(x)]);
+}
+
+// Bilinear lookup; returns the raw (non-linearised) texel values.
+vec4 nb_sample_texture(int texture, vec2 uv) {
+    GpuTextureInfo ti = texture_infos[texture];
+    // Keep the coordinates bounded before scaling so huge uvs cannot overflow the int conversion.
+    uv = uv - floor(uv);
+    vec2 p = uv * vec2(float(ti.width), float(ti.height)) - 0.5f;
+    vec2 f = p - floor(p);
+    int x = int(floor(p.x));
+    int y = int(floor(p.y));
+    vec4 a = nb_texel(ti, x, y), b = nb_texel(ti, x + 1, y);
+    vec4 c = nb_texel(ti, x, y + 1), d = nb_texel(ti, x + 1, y + 1);
+    return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
+}
+
+vec3 nb_srgb_to_linear3(vec3 c) {
+    return vec3(nb_srgb_to_linear(c.x), nb_srgb_to_linear(c.y), nb_srgb_to_linear(c.z));
+}
+
+// Texture coordinates of a reference at a surface point (KHR_texture_transform applied).
+vec2 nb_tex_coord(GpuTexRef ref, vec2 uv0, vec2 uv1) {
+    vec3 uv = vec3(ref.uv_set == 1u ? uv1 : uv0, 1.0f);
+    vec2 r = vec2(dot(ref.row0, uv), dot(ref.row1, uv));
+    // Non-finite uvs (bad input) fall back to the origin instead of poisoning the texel index.
+    return (isnan(r.x) || isinf(r.x) || isnan(r.y) || isinf(r.y)) ? vec2(0.0f) : r;
+}
+
+// Interpolated uv sets of a triangle at barycentrics (u, v) of vertices 1 and 2.
+void nb_triangle_uvs(GpuTriangle tri, vec2 bary, out vec2 uv0, out vec2 uv1) {
+    GpuVertex a = vertices[tri.v0], b = vertices[tri.v1], c = vertices[tri.v2];
+    float w = 1.0f - bary.x - bary.y;
+    uv0 = w * vec2(a.u0, a.v0) + bary.x * vec2(b.u0, b.v0) + bary.y * vec2(c.u0, c.v0);
+    uv1 = w * a.uv1 + bary.x * b.uv1 + bary.y * c.uv1;
+}
+
+// Base-colour alpha of a material at a surface point (for alpha masks).
+float nb_material_alpha(GpuMaterial m, GpuTriangle tri, vec2 bary) {
+    float alpha = m.base_color.w;
+    if (NB_HAS_TEXTURES && m.base_color_tex.texture >= 0) {
+        vec2 uv0, uv1;
+        nb_triangle_uvs(tri, bary, uv0, uv1);
+        alpha *= nb_sample_texture(m.base_color_tex.texture, nb_tex_coord(m.base_color_tex, uv0, uv1)).w;
+    }
+    return alpha;
+}
+
+#endif

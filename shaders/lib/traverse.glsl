@@ -1,0 +1,146 @@
+// Two-level BVH traversal (TLAS over instances, one BLAS per mesh) for the wavefront passes.
+//
+// The traversal loop (NB_TRAVERSE_BVH) is written once and knows nothing of what a leaf contains: it
+// hands (first, count) of each leaf it reaches to a leaf handler (madmann91/bvh). Two handlers exist:
+//   - nb_instance_leaf: a TLAS leaf, i.e. instances; it dispatches on the instance kind. Triangle
+//     instances transform the ray and traverse their BLAS with nb_triangle_leaf. The neural issue adds
+//     the NB_INSTANCE_NEURAL case (traverse the N-BVH, append (ray, leaf) pairs to the pending-leaf
+//     queue and suspend the ray at the nearest one) without touching the triangle path.
+//   - nb_triangle_leaf: ray/triangle tests (shared/intersect.h), alpha masks when the scene has them.
+//
+// State lives in per-invocation globals (GLSL has neither references nor recursion). Rays are not
+// re-normalised in object space, so t is the same distance in world and object space.
+#ifndef NB_TRAVERSE_GLSL
+#define NB_TRAVERSE_GLSL
+#include "lib/bindings.glsl"
+#include "lib/textures.glsl"
+#include "shared/intersect.h"
+
+vec3 g_org;            // world-space ray
+vec3 g_dir;
+float g_tmin;
+float g_tmax;          // shrinks to the closest accepted hit
+uint g_hit_instance;   // NB_NO_HIT until a hit is accepted
+uint g_hit_triangle;
+vec2 g_hit_bary;
+bool g_any_hit;        // shadow rays: stop at the first accepted hit
+bool g_done;
+uint g_alpha_seed;     // per-ray random bits for stochastic alpha blending
+uint g_cur_instance;   // instance whose BLAS is being traversed
+vec3 g_obj_org;        // the ray in that instance's object space
+vec3 g_obj_dir;
+
+// Iterative nearest-first traversal of one two-child BVH. NODES: node array; ROOT: root node index
+// (an interior node); ORG, INV_DIR: the ray in the tree's space; LEAF(first, count): the leaf handler.
+// Culls by g_tmin/g_tmax (the handler narrows g_tmax) and stops when g_done is set. Stack entries
+// keep their entry distance so that subtrees behind a hit found meanwhile are skipped.
+#define NB_TRAVERSE_BVH(NODES, ROOT, ORG, INV_DIR, LEAF)                                             \
+    {                                                                                                \
+        uint nb_stack_ref[NB_BVH_MAX_DEPTH + 1u];                                                    \
+        float nb_stack_t[NB_BVH_MAX_DEPTH + 1u];                                                     \
+        uint nb_sp = 1u;                                                                             \
+        nb_stack_ref[0] = (ROOT);                                                                    \
+        nb_stack_t[0] = g_tmin;                                                                      \
+        while (nb_sp > 0u && !g_done) {                                                              \
+            nb_sp--;                                                                                 \
+            uint nb_ref = nb_stack_ref[nb_sp];                                                       \
+            if (nb_stack_t[nb_sp] > g_tmax) continue;                                                \
+            if (nb_is_leaf(nb_ref)) {                                                                \
+                LEAF(nb_leaf_first(nb_ref), nb_leaf_count(nb_ref));                                  \
+                continue;                                                                            \
+            }                                                                                        \
+            GpuBvhNode nb_n = NODES[nb_ref];                                                         \
+            float nb_tl, nb_tr;                                                                      \
+            bool nb_hl = nb_n.left != NB_CHILD_NONE &&                                               \
+                         nb_intersect_aabb(ORG, INV_DIR, nb_n.lmin, nb_n.lmax, g_tmin, g_tmax, nb_tl); \
+            bool nb_hr = nb_n.right != NB_CHILD_NONE &&                                              \
+                         nb_intersect_aabb(ORG, INV_DIR, nb_n.rmin, nb_n.rmax, g_tmin, g_tmax, nb_tr); \
+            if (nb_hl && nb_hr && nb_sp + 2u <= NB_BVH_MAX_DEPTH + 1u) {                             \
+                bool nb_left_first = nb_tl <= nb_tr;                                                 \
+                nb_stack_ref[nb_sp] = nb_left_first ? nb_n.right : nb_n.left;                        \
+                nb_stack_t[nb_sp] = nb_left_first ? nb_tr : nb_tl;                                   \
+                nb_stack_ref[nb_sp + 1u] = nb_left_first ? nb_n.left : nb_n.right;                   \
+                nb_stack_t[nb_sp + 1u] = nb_left_first ? nb_tl : nb_tr;                              \
+                nb_sp += 2u;                                                                         \
+            } else if (nb_hl && nb_sp < NB_BVH_MAX_DEPTH + 1u) {                                     \
+                nb_stack_ref[nb_sp] = nb_n.left;                                                     \
+                nb_stack_t[nb_sp] = nb_tl;                                                           \
+                nb_sp++;                                                                             \
+            } else if (nb_hr && nb_sp < NB_BVH_MAX_DEPTH + 1u) {                                     \
+                nb_stack_ref[nb_sp] = nb_n.right;                                                    \
+                nb_stack_t[nb_sp] = nb_tr;                                                           \
+                nb_sp++;                                                                             \
+            }                                                                                        \
+        }                                                                                            \
+    }
+
+// Whether a hit on a triangle counts: alpha masks cut it out; alpha blending is stochastic (the
+// surface is hit with probability alpha), which keeps the estimator unbiased without sorting hits.
+bool nb_alpha_accepts(GpuTriangle tri, vec2 bary) {
+    if (!NB_HAS_ALPHA_MASK) return true;
+    GpuMaterial m = materials[tri.material];
+    if (m.alpha_mode == NB_ALPHA_OPAQUE) return true;
+    float alpha = nb_material_alpha(m, tri, bary);
+    if (m.alpha_mode == NB_ALPHA_MASK) return alpha >= m.alpha_cutoff;
+    uint h = nb_pcg_hash(g_alpha_seed ^ nb_pcg_hash(floatBitsToUint(bary.x) + tri.v0));
+    return float(h >> 8u) * (1.0f / 16777216.0f) < alpha;
+}
+
+// BLAS leaf: triangles first .. first+count-1 of the current instance's mesh (BLAS leaf order).
+void nb_triangle_leaf(uint first, uint count) {
+    GpuInstance inst = instances[g_cur_instance];
+    for (uint k = 0u; k < count; ++k) {
+        uint tri_index = inst.first_triangle + first + k;
+        GpuTriangle tri = triangles[tri_index];
+        float t, u, v;
+        if (!nb_intersect_triangle(g_obj_org, g_obj_dir, vertices[tri.v0].position, vertices[tri.v1].position,
+                                   vertices[tri.v2].position, g_tmin, g_tmax, t, u, v))
+            continue;
+        if (!nb_alpha_accepts(tri, vec2(u, v))) continue;
+        g_tmax = t;
+        g_hit_instance = g_cur_instance;
+        g_hit_triangle = tri_index;
+        g_hit_bary = vec2(u, v);
+        if (g_any_hit) {
+            g_done = true;
+            return;
+        }
+    }
+}
+
+void nb_traverse_triangle_instance(uint instance) {
+    GpuInstance inst = instances[instance];
+    g_cur_instance = instance;
+    g_obj_org = nb_xform_point(inst.world_to_object, g_org);
+    g_obj_dir = nb_xform_vector(inst.world_to_object, g_dir);
+    vec3 inv_dir = nb_safe_inv_dir(g_obj_dir);
+    NB_TRAVERSE_BVH(blas_nodes, inst.blas_root, g_obj_org, inv_dir, nb_triangle_leaf)
+}
+
+// TLAS leaf: instances first .. first+count-1 (TLAS leaf order), dispatched on their kind.
+void nb_instance_leaf(uint first, uint count) {
+    for (uint k = 0u; k < count && !g_done; ++k) {
+        uint instance = first + k;
+        uint kind = instances[instance].kind;
+        if (kind == NB_INSTANCE_TRIANGLES) nb_traverse_triangle_instance(instance);
+        // NB_INSTANCE_NEURAL: handled by the neural leaf handler (next issue), only when NB_HAS_NEURAL.
+    }
+}
+
+// Closest (any_hit = false) or any (true) hit along org + t dir, t in [tmin, tmax]. Results in g_hit_*.
+void nb_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit) {
+    g_org = org;
+    g_dir = dir;
+    g_tmin = tmin;
+    g_tmax = tmax;
+    g_hit_instance = NB_NO_HIT;
+    g_hit_triangle = 0u;
+    g_hit_bary = vec2(0.0f);
+    g_any_hit = any_hit;
+    g_done = false;
+    if (params.instance_count == 0u) return;
+    vec3 inv_dir = nb_safe_inv_dir(dir);
+    NB_TRAVERSE_BVH(tlas_nodes, 0u, g_org, inv_dir, nb_instance_leaf)
+}
+
+#endif

@@ -1,0 +1,36 @@
+// Pass 1: one camera ray per pixel of the wave into path-ray queue pc.in_queue (pinhole camera,
+// uniform jitter inside the pixel, row 0 at the top). Also clears the wave's sample radiance.
+#version 460
+#include "lib/bindings.glsl"
+#include "shared/sampling.h"
+
+layout(local_size_x = NB_WAVEFRONT_GROUP) in;
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i == 0u) {
+        if (pc.in_queue == 0u) counters.ray_count0 = pc.pixel_count;
+        else counters.ray_count1 = pc.pixel_count;
+    }
+    if (i >= pc.pixel_count) return;
+    uint pixel = pc.pixel_offset + i;
+    uint x = pixel % params.width;
+    uint y = pixel / params.width;
+    uint rng = nb_rng_init(pixel, pc.sample_index, params.seed);
+    float jx = nb_rng_next(rng);
+    float jy = nb_rng_next(rng);
+    float sx = (2.0f * (float(x) + jx) / float(params.width) - 1.0f) * params.aspect * params.cam_tan_half_fov;
+    float sy = (1.0f - 2.0f * (float(y) + jy) / float(params.height)) * params.cam_tan_half_fov;
+    vec3 dir = normalize(params.cam_forward + sx * params.cam_right + sy * params.cam_up);
+
+    uint q = pc.in_queue;
+    ray_store3(q, NB_RAY_ORIGIN, i, params.cam_eye);
+    ray_store3(q, NB_RAY_DIR, i, dir);
+    ray_store3(q, NB_RAY_THROUGHPUT, i, vec3(1.0f));
+    ray_store1(q, NB_RAY_PIXEL, i, pixel);
+    ray_store1(q, NB_RAY_DEPTH, i, 0u);
+    ray_store1(q, NB_RAY_RNG, i, rng);
+    ray_store1(q, NB_RAY_PDF, i, floatBitsToUint(-1.0f));
+    ray_store1(q, NB_RAY_T_RESUME, i, floatBitsToUint(0.0f));
+    sample_radiance[i] = vec3(0.0f);
+}

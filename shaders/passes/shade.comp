@@ -1,0 +1,122 @@
+// Pass 3: shades the closest hit of every ray in queue pc.in_queue.
+//   miss  -> environment radiance (MIS-weighted against environment NEE);
+//   hit   -> emitted radiance (MIS-weighted against emissive NEE), then, if the path may grow:
+//            next-event estimation: one light sample (environment or emissive triangle), evaluated
+//            here and appended to the shadow queue with its MIS weight (power heuristic);
+//            BSDF sampling + Russian roulette: the continuation ray is appended to queue 1 - in_queue.
+// Radiance goes to sample_radiance[pixel - pixel_offset] (one path per pixel per wave: no races).
+#version 460
+#include "lib/bindings.glsl"
+#include "lib/material.glsl"
+#include "lib/env.glsl"
+#include "lib/lights.glsl"
+
+layout(local_size_x = NB_WAVEFRONT_GROUP) in;
+
+// Probability of sampling the environment (vs. emissive triangles) in next-event estimation.
+float env_choice_probability() {
+    if (!NB_HAS_ENVIRONMENT) return 0.0f;
+    if (!NB_HAS_EMISSION || params.light_count == 0u) return 1.0f;
+    return 0.5f;
+}
+
+vec3 ray_offset(vec3 p, vec3 n) {
+    vec3 ap = abs(p);
+    return p + n * (params.ray_epsilon + 4.0e-6f * max(ap.x, max(ap.y, ap.z)));
+}
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    uint q = pc.in_queue;
+    if (i >= queue_count(q)) return;
+    vec3 org = ray_load3(q, NB_RAY_ORIGIN, i);
+    vec3 dir = ray_load3(q, NB_RAY_DIR, i);
+    vec3 throughput = ray_load3(q, NB_RAY_THROUGHPUT, i);
+    uint pixel = ray_load1(q, NB_RAY_PIXEL, i);
+    uint depth = ray_load1(q, NB_RAY_DEPTH, i);
+    uint rng = ray_load1(q, NB_RAY_RNG, i);
+    float prev_pdf = uintBitsToFloat(ray_load1(q, NB_RAY_PDF, i));
+    uint local_pixel = pixel - pc.pixel_offset;
+    float p_env = env_choice_probability();
+
+    uint instance = hit_load1(NB_HIT_INSTANCE, i);
+    if (instance == NB_NO_HIT) {
+        if (NB_HAS_ENVIRONMENT) {
+            float w = 1.0f;
+            if (prev_pdf > 0.0f) w = nb_power_heuristic(prev_pdf, p_env * nb_env_pdf(dir));
+            sample_radiance[local_pixel] += throughput * nb_env_radiance(dir) * w;
+        }
+        return;
+    }
+    float t = uintBitsToFloat(hit_load1(NB_HIT_T, i));
+    uint tri_index = hit_load1(NB_HIT_TRIANGLE, i);
+    Surface s = nb_make_surface(instance, tri_index, hit_load_bary(i), org, dir, t);
+    vec3 wo = -dir;
+
+    if (NB_HAS_EMISSION && dot(s.emission, s.emission) > 0.0f) {
+        float w = 1.0f;
+        if (prev_pdf > 0.0f && params.light_count > 0u) {
+            float cos_l = abs(dot(s.ng, dir));
+            float light_pdf = (1.0f - p_env) * nb_emissive_area_pdf(materials[s.material]) * t * t / max(cos_l, 1.0e-8f);
+            w = nb_power_heuristic(prev_pdf, light_pdf);
+        }
+        sample_radiance[local_pixel] += throughput * s.emission * w;
+    }
+    if (depth + 1u >= params.max_depth) return; // the next segment would exceed --max-depth
+
+    // Next-event estimation.
+    if (NB_HAS_ENVIRONMENT || NB_HAS_EMISSION) {
+        vec3 wi;
+        float light_pdf = 0.0f, dist = NB_INF;
+        vec3 le = vec3(0.0f);
+        bool pick_env = nb_rng_next(rng) < p_env;
+        if (NB_HAS_ENVIRONMENT && pick_env) {
+            le = nb_env_sample(rng, wi, light_pdf);
+            light_pdf *= p_env;
+        } else if (NB_HAS_EMISSION && params.light_count > 0u) {
+            le = nb_emissive_sample(s.p, rng, wi, dist, light_pdf);
+            light_pdf *= 1.0f - p_env;
+        }
+        if (light_pdf > 0.0f && dot(le, le) > 0.0f) {
+            float bsdf_pdf;
+            vec3 f = nb_bsdf_eval(s, wo, wi, bsdf_pdf);
+            if (dot(f, f) > 0.0f) {
+                vec3 contrib = throughput * f * le * (nb_power_heuristic(light_pdf, bsdf_pdf) / light_pdf);
+                uint k = atomicAdd(counters.shadow_count, 1u);
+                vec3 o = ray_offset(s.p, s.ng);
+                shadow_store3(NB_SHADOW_ORIGIN, k, o);
+                shadow_store3(NB_SHADOW_DIR, k, wi);
+                // Stop short of the light's surface so the emitter does not occlude itself.
+                float tmax = dist >= NB_INF ? NB_INF : max(0.0f, length(s.p + wi * dist - o) * (1.0f - 1.0e-4f));
+                shadow_store1(NB_SHADOW_TMAX, k, floatBitsToUint(tmax));
+                shadow_store3(NB_SHADOW_CONTRIB, k, contrib);
+                shadow_store1(NB_SHADOW_PIXEL, k, pixel);
+            }
+        }
+    }
+
+    // Continuation.
+    vec3 wi, weight;
+    float pdf;
+    if (!nb_bsdf_sample(s, wo, rng, wi, weight, pdf)) return;
+    throughput *= weight;
+    if (depth + 1u >= params.rr_start_depth) {
+        float survive = min(1.0f, max(throughput.x, max(throughput.y, throughput.z)));
+        if (!(nb_rng_next(rng) < survive)) return;
+        throughput /= survive;
+    }
+    if (!(max(throughput.x, max(throughput.y, throughput.z)) > 0.0f)) return;
+    // Without anything to sample by NEE, emitters hit by BSDF sampling take the full weight.
+    if (!(NB_HAS_ENVIRONMENT || NB_HAS_EMISSION)) pdf = -1.0f;
+    uint out_q = 1u - q;
+    uint k = out_q == 0u ? atomicAdd(counters.ray_count0, 1u) : atomicAdd(counters.ray_count1, 1u);
+    vec3 n_side = dot(wi, s.ng) >= 0.0f ? s.ng : -s.ng; // transmission leaves through the back
+    ray_store3(out_q, NB_RAY_ORIGIN, k, ray_offset(s.p, n_side));
+    ray_store3(out_q, NB_RAY_DIR, k, wi);
+    ray_store3(out_q, NB_RAY_THROUGHPUT, k, throughput);
+    ray_store1(out_q, NB_RAY_PIXEL, k, pixel);
+    ray_store1(out_q, NB_RAY_DEPTH, k, depth + 1u);
+    ray_store1(out_q, NB_RAY_RNG, k, rng);
+    ray_store1(out_q, NB_RAY_PDF, k, floatBitsToUint(pdf));
+    ray_store1(out_q, NB_RAY_T_RESUME, k, floatBitsToUint(0.0f));
+}

@@ -1,0 +1,22 @@
+// Pass 4: any-hit visibility of every shadow ray; an unoccluded ray adds its (MIS-weighted) light
+// contribution to its pixel's sample radiance. Only built when the scene has lights to sample.
+#version 460
+#include "lib/bindings.glsl"
+#include "lib/traverse.glsl"
+
+layout(local_size_x = NB_WAVEFRONT_GROUP) in;
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= counters.shadow_count) return;
+    vec3 org = shadow_load3(NB_SHADOW_ORIGIN, i);
+    vec3 dir = shadow_load3(NB_SHADOW_DIR, i);
+    float tmax = uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, i));
+    uint pixel = shadow_load1(NB_SHADOW_PIXEL, i);
+    g_alpha_seed = nb_pcg_hash(pixel ^ (pc.depth << 24u) ^ pc.sample_index);
+    nb_trace(org, dir, 0.0f, tmax, true);
+    if (g_hit_instance == NB_NO_HIT) {
+        // At most one shadow ray per path per bounce and one path per pixel per wave: no write races.
+        sample_radiance[pixel - pc.pixel_offset] += shadow_load3(NB_SHADOW_CONTRIB, i);
+    }
+}

@@ -1,0 +1,141 @@
+// Random numbers, direction sampling, the glTF metallic-roughness BSDF pieces (Lambert + GGX) and
+// the environment parameterisation, shared by the path-tracing shaders and the C++ tests that check
+// them (pdf normalisation, determinism). Units: solid-angle pdfs in 1/sr.
+#ifndef NB_SAMPLING_H
+#define NB_SAMPLING_H
+#include "compat.h"
+
+#define NB_PI 3.14159265358979f
+#define NB_INV_PI 0.318309886183791f
+
+#ifdef NB_GLSL
+#define nb_atan2(y, x) atan(y, x)
+#else
+NB_FN float nb_atan2(float y, float x) { return atan2f(y, x); }
+#endif
+
+// ---- Random numbers: PCG hash (Jarzynski & Olano 2020, "Hash Functions for GPU Rendering") ------
+NB_FN uint nb_pcg_hash(uint v) {
+    uint state = v * 747796405u + 2891336453u;
+    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// Sampler state of one path: independent per pixel, sample and --seed.
+NB_FN uint nb_rng_init(uint pixel, uint sample_index, uint seed) {
+    return nb_pcg_hash(pixel ^ nb_pcg_hash(sample_index ^ nb_pcg_hash(seed + 0x9E3779B9u)));
+}
+
+// Uniform float in [0, 1) with 24 bits; advances the state.
+NB_FN float nb_rng_next(NB_INOUT(uint) state) {
+    state = state * 747796405u + 2891336453u;
+    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    word = (word >> 22u) ^ word;
+    return float(word >> 8u) * (1.0f / 16777216.0f);
+}
+
+// ---- Helpers --------------------------------------------------------------------------------------
+NB_FN float nb_luminance(vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+NB_FN float nb_srgb_to_linear(float c) {
+    return c <= 0.04045f ? c * (1.0f / 12.92f) : pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
+}
+
+// Orthonormal basis around unit n (Duff et al. 2017, "Building an Orthonormal Basis, Revisited").
+NB_FN void nb_make_basis(vec3 n, NB_OUT(vec3) t, NB_OUT(vec3) b) {
+    float s = n.z >= 0.0f ? 1.0f : -1.0f;
+    float a = -1.0f / (s + n.z);
+    float c = n.x * n.y * a;
+    t = vec3(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
+    b = vec3(c, s + n.y * n.y * a, -n.y);
+}
+
+// Power heuristic with beta = 2 (Veach 1997), for one sample from each strategy.
+NB_FN float nb_power_heuristic(float pdf_a, float pdf_b) {
+    float a = pdf_a * pdf_a;
+    float b = pdf_b * pdf_b;
+    return a + b > 0.0f ? a / (a + b) : 0.0f;
+}
+
+// ---- Lambert ------------------------------------------------------------------------------------
+// Cosine-weighted hemisphere around +z (local frame); pdf = cos(theta) / pi.
+NB_FN vec3 nb_sample_cosine(float u1, float u2) {
+    float r = sqrt(u1);
+    float phi = 2.0f * NB_PI * u2;
+    return vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0f, 1.0f - u1)));
+}
+
+// ---- GGX (Trowbridge-Reitz) with height-correlated Smith masking --------------------------------
+// alpha = roughness^2 (glTF), clamped so that a perfect mirror stays numerically well-behaved.
+NB_FN float nb_ggx_alpha(float roughness) { return max(1.0e-3f, roughness * roughness); }
+
+NB_FN float nb_ggx_d(float n_dot_h, float alpha) {
+    float a2 = alpha * alpha;
+    float d = n_dot_h * n_dot_h * (a2 - 1.0f) + 1.0f;
+    return a2 / max(NB_PI * d * d, 1.0e-20f);
+}
+
+// Visibility term V = G2 / (4 n.l n.v) (height-correlated, glTF spec appendix B).
+NB_FN float nb_ggx_v(float n_dot_l, float n_dot_v, float alpha) {
+    float a2 = alpha * alpha;
+    float gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0f - a2) + a2);
+    float gl = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0f - a2) + a2);
+    return 0.5f / max(gv + gl, 1.0e-20f);
+}
+
+NB_FN float nb_ggx_g1(float n_dot_v, float alpha) {
+    float a2 = alpha * alpha;
+    return 2.0f * n_dot_v / max(n_dot_v + sqrt(a2 + (1.0f - a2) * n_dot_v * n_dot_v), 1.0e-20f);
+}
+
+// Visible-normal sampling (Heitz 2018, "Sampling the GGX Distribution of Visible Normals"); wo and the
+// returned half vector are in the local frame (+z = normal).
+NB_FN vec3 nb_ggx_sample_vndf(vec3 wo, float alpha, float u1, float u2) {
+    vec3 vh = normalize(vec3(alpha * wo.x, alpha * wo.y, wo.z));
+    float lensq = vh.x * vh.x + vh.y * vh.y;
+    vec3 t1 = lensq > 0.0f ? vec3(-vh.y, vh.x, 0.0f) * inversesqrt(lensq) : vec3(1.0f, 0.0f, 0.0f);
+    vec3 t2 = cross(vh, t1);
+    float r = sqrt(u1);
+    float phi = 2.0f * NB_PI * u2;
+    float p1 = r * cos(phi);
+    float p2 = r * sin(phi);
+    float s = 0.5f * (1.0f + vh.z);
+    p2 = (1.0f - s) * sqrt(max(0.0f, 1.0f - p1 * p1)) + s * p2;
+    vec3 nh = p1 * t1 + p2 * t2 + sqrt(max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
+    return normalize(vec3(alpha * nh.x, alpha * nh.y, max(1.0e-6f, nh.z)));
+}
+
+// Solid-angle pdf of a reflected direction produced by nb_ggx_sample_vndf: G1(wo) D(h) / (4 n.v).
+NB_FN float nb_ggx_pdf(float n_dot_v, float n_dot_h, float alpha) {
+    return nb_ggx_g1(n_dot_v, alpha) * nb_ggx_d(n_dot_h, alpha) / max(4.0f * n_dot_v, 1.0e-20f);
+}
+
+NB_FN vec3 nb_fresnel_schlick(vec3 f0, float cos_theta) {
+    float m = clamp(1.0f - cos_theta, 0.0f, 1.0f);
+    float m5 = m * m * m * m * m;
+    return f0 + (vec3(1.0f) - f0) * m5;
+}
+
+// ---- Environment (equirectangular, official implementation §8 convention) ------------------------
+// u = atan2(d.x, -d.z) / 2pi + 0.5, v = acos(d.y) / pi, after rotating d by `rotation` about +y.
+NB_FN vec2 nb_env_dir_to_uv(vec3 d, float rotation) {
+    float c = cos(rotation);
+    float s = sin(rotation);
+    vec3 r = vec3(c * d.x + s * d.z, d.y, -s * d.x + c * d.z);
+    float u = nb_atan2(r.x, -r.z) * (0.5f * NB_INV_PI) + 0.5f;
+    float v = acos(clamp(r.y, -1.0f, 1.0f)) * NB_INV_PI;
+    return vec2(u - floor(u), v);
+}
+
+NB_FN vec3 nb_env_uv_to_dir(vec2 uv, float rotation) {
+    float phi = (uv.x - 0.5f) * 2.0f * NB_PI;
+    float theta = uv.y * NB_PI;
+    float st = sin(theta);
+    vec3 r = vec3(st * sin(phi), cos(theta), -st * cos(phi));
+    float c = cos(rotation);
+    float s = sin(rotation);
+    // inverse of the rotation in nb_env_dir_to_uv
+    return vec3(c * r.x - s * r.z, r.y, s * r.x + c * r.z);
+}
+
+#endif

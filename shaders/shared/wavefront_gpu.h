@@ -1,0 +1,108 @@
+// Wavefront path-tracer state shared by host and shaders: the structure-of-arrays ray, hit and
+// shadow-ray buffers, the queue counters with their indirect-dispatch arguments, and the per-pass
+// push constants. See engine/render/README.md for the pass sequence.
+//
+// SOA layout: a buffer is one array of 32-bit words; field f of element i with c components lives at
+// word  base + f_offset * capacity + i * c + comp  where f_offset counts words of all earlier fields.
+// Every element of a field is contiguous, so a pass that reads only directions touches only them.
+#ifndef NB_WAVEFRONT_GPU_H
+#define NB_WAVEFRONT_GPU_H
+#include "compat.h"
+
+// Threads per workgroup of every 1-D pass (indirect dispatch arguments are computed with it). A
+// multiple of 32 and of lavapipe's 8; no pass relies on the subgroup size.
+#define NB_WAVEFRONT_GROUP 64u
+
+// ---- Path rays (two ping-pong queues of `capacity` rays each) -----------------------------------
+// word offsets of each field within one queue (times capacity)
+#define NB_RAY_ORIGIN 0u      // vec3 world space
+#define NB_RAY_DIR 3u         // vec3 world space, unit length
+#define NB_RAY_THROUGHPUT 6u  // vec3 path throughput (already divided by pdfs and RR)
+#define NB_RAY_PIXEL 9u       // uint pixel index within the image
+#define NB_RAY_DEPTH 10u      // uint segment index of this ray (0 = camera ray)
+#define NB_RAY_RNG 11u        // uint sampler state
+#define NB_RAY_PDF 12u        // float solid-angle pdf of the BSDF sample that made this ray; < 0: delta lobe
+                              // or camera ray (no MIS on the emitter it hits)
+#define NB_RAY_T_RESUME 13u   // float traversal resume distance (neural leaves: ray suspended at a
+                              // leaf continues from here after the neural query; 0 otherwise)
+#define NB_RAY_WORDS 14u
+
+NB_FN uint nb_ray_word(uint queue, uint field, uint capacity, uint index, uint components) {
+    return queue * NB_RAY_WORDS * capacity + field * capacity + index * components;
+}
+
+// ---- Closest hits, one per slot of the queue being traced ---------------------------------------
+#define NB_HIT_T 0u         // float distance along the ray (NB_INF: miss)
+#define NB_HIT_INSTANCE 1u  // uint instance (NB_NO_HIT: miss)
+#define NB_HIT_TRIANGLE 2u  // uint global triangle index
+#define NB_HIT_BARY 3u      // vec2 barycentrics (u, v) of v1, v2
+#define NB_HIT_WORDS 5u
+#define NB_NO_HIT 0xFFFFFFFFu
+
+NB_FN uint nb_hit_word(uint field, uint capacity, uint index, uint components) {
+    return field * capacity + index * components;
+}
+
+// ---- Shadow rays (one queue; at most one per path per bounce) ------------------------------------
+#define NB_SHADOW_ORIGIN 0u       // vec3
+#define NB_SHADOW_DIR 3u          // vec3 unit length
+#define NB_SHADOW_TMAX 6u         // float distance to the light sample (NB_INF: environment)
+#define NB_SHADOW_CONTRIB 7u      // vec3 radiance added to the path when unoccluded (MIS-weighted)
+#define NB_SHADOW_PIXEL 10u       // uint pixel index within the image
+#define NB_SHADOW_WORDS 11u
+
+NB_FN uint nb_shadow_word(uint field, uint capacity, uint index, uint components) {
+    return field * capacity + index * components;
+}
+
+// ---- Pending (ray, neural leaf) pairs (neural issue; allocated with a minimal size until then) ----
+struct GpuPendingLeaf {
+    uint ray;       // slot in the current path-ray queue
+    uint instance;  // the neural instance
+    uint leaf;      // N-BVH leaf index
+    float t_enter;  // leaf interval along the ray (world t)
+    float t_exit;
+};
+NB_STATIC_ASSERT(sizeof(GpuPendingLeaf) == 20, "GpuPendingLeaf layout");
+
+// ---- Queue counters and indirect arguments -------------------------------------------------------
+struct GpuDispatchArgs {
+    uint x, y, z;
+};
+NB_STATIC_ASSERT(sizeof(GpuDispatchArgs) == 12, "GpuDispatchArgs layout");
+
+// One buffer (storage + indirect usage). Byte offsets of the dispatch arguments are fixed below so
+// the host can pass them to vkCmdDispatchIndirect.
+struct GpuQueueCounters {
+    GpuDispatchArgs ray_dispatch;    // byte offset 0: groups for the current path-ray queue
+    GpuDispatchArgs shadow_dispatch; // byte offset 12
+    GpuDispatchArgs pending_dispatch;// byte offset 24 (neural query, later issue)
+    uint ray_count0;                 // rays in queue 0
+    uint ray_count1;                 // rays in queue 1
+    uint shadow_count;
+    uint pending_count;
+    uint rays_primary;               // statistics (counted on the GPU)
+    uint rays_secondary;
+    uint rays_shadow;
+    uint nonfinite_samples;          // path samples dropped by accumulate because they were NaN/Inf
+};
+NB_STATIC_ASSERT(sizeof(GpuQueueCounters) == 68, "GpuQueueCounters layout");
+#define NB_COUNTERS_RAY_DISPATCH_OFFSET 0u
+#define NB_COUNTERS_SHADOW_DISPATCH_OFFSET 12u
+#define NB_COUNTERS_PENDING_DISPATCH_OFFSET 24u
+
+// ---- Push constants (<= 128 bytes, the Vulkan minimum) --------------------------------------------
+#define NB_ARGS_MODE_RAYS 0u    // queue_args.comp: arguments for path-ray queue `in_queue`
+#define NB_ARGS_MODE_SHADOW 1u  // queue_args.comp: arguments for the shadow queue
+
+struct GpuPassConstants {
+    uint in_queue;      // path-ray queue read by this pass (0 or 1)
+    uint depth;         // segment index being traced
+    uint sample_index;  // sample of the pixel (0 .. spp-1)
+    uint pixel_offset;  // first pixel of the current wave
+    uint pixel_count;   // pixels in the current wave
+    uint mode;          // pass-specific (NB_ARGS_MODE_*)
+};
+NB_STATIC_ASSERT(sizeof(GpuPassConstants) == 24, "GpuPassConstants layout");
+
+#endif

@@ -1,0 +1,83 @@
+// CPU packing of the scene for the shaders: BVH references, lights and their cdf, environment table.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "engine/bvh/scene_accel.h"
+#include "engine/render/environment_sampler.h"
+#include "engine/render/gpu_scene.h"
+#include "tests/render/test_scenes.h"
+
+namespace nbvh::render {
+namespace {
+
+TEST(GpuScene, PacksQuadWithInstancesInTlasOrder) {
+    Scene s = test::make_quad_scene();
+    Instance second = s.instances[0];
+    second.object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(3, 0, 0));
+    s.instances.push_back(second);
+    const SceneAccel accel = build_scene_accel(s);
+    const GpuSceneData d = pack_scene(s, accel, Environment{});
+    ASSERT_EQ(d.instances.size(), 2u);
+    ASSERT_EQ(d.triangles.size(), 2u);
+    EXPECT_EQ(d.instance_to_scene.size(), 2u);
+    for (size_t i = 0; i < 2; ++i) {
+        const uint32_t si = d.instance_to_scene[i];
+        EXPECT_FLOAT_EQ(d.instances[i].object_to_world[0].w, si == 1 ? 3.0f : 0.0f);
+    }
+    // Every interior reference points inside the BLAS array.
+    for (const GpuBvhNode& n : d.blas_nodes)
+        for (uint32_t ref : {n.left, n.right})
+            if (!nb_is_leaf(ref) && ref != NB_CHILD_NONE) EXPECT_LT(ref, d.blas_nodes.size());
+    EXPECT_EQ(d.light_total_power, 0.0f);
+}
+
+TEST(GpuScene, EmissiveTrianglesBecomePowerWeightedLights) {
+    Scene s = test::make_quad_scene();
+    s.materials[0].emissive = glm::vec3(1.0f);
+    s.instances[0].object_to_world = glm::scale(glm::mat4(1.0f), glm::vec3(2.0f)); // area x4
+    const SceneAccel accel = build_scene_accel(s);
+    const GpuSceneData d = pack_scene(s, accel, Environment{});
+    ASSERT_EQ(d.lights.size(), 2u);
+    EXPECT_NEAR(d.lights[0].area + d.lights[1].area, 16.0f, 1e-4f); // 2x2 quad scaled by 2
+    EXPECT_NEAR(d.light_total_power, 16.0f, 1e-3f);                // luminance(1,1,1) = 1
+    ASSERT_EQ(d.light_cdf.size(), 3u);
+    EXPECT_FLOAT_EQ(d.light_cdf[0], 0.0f);
+    EXPECT_NEAR(d.light_cdf[1], 0.5f, 1e-5f);
+    EXPECT_FLOAT_EQ(d.light_cdf[2], 1.0f);
+}
+
+TEST(EnvironmentTable, CdfsAreMonotoneAndDensityAveragesToOne) {
+    Environment env;
+    env.width = 16;
+    env.height = 8;
+    env.rgb.resize(16 * 8 * 3);
+    for (size_t i = 0; i < env.rgb.size(); ++i) env.rgb[i] = float((i * 7919) % 13) * 0.1f;
+    env.rgb[5] = NAN; // bad texel reads as 0
+    const EnvironmentTable t = build_environment_table(env);
+    const float* marginal = t.data.data() + 16 * 8 * 3;
+    for (uint32_t y = 0; y < 8; ++y) EXPECT_LE(marginal[y], marginal[y + 1]);
+    EXPECT_FLOAT_EQ(marginal[8], 1.0f);
+    double mean = 0.0;
+    for (uint32_t y = 0; y < 8; ++y)
+        for (uint32_t x = 0; x < 16; ++x) {
+            const float d = environment_density(t, x, y);
+            EXPECT_TRUE(std::isfinite(d));
+            mean += d;
+        }
+    EXPECT_NEAR(mean / (16 * 8), 1.0, 1e-4);
+}
+
+TEST(EnvironmentTable, ConstantEnvironmentIsOneTexel) {
+    Environment env;
+    env.constant = glm::vec3(0.5f);
+    const EnvironmentTable t = build_environment_table(env);
+    EXPECT_EQ(t.width, 1u);
+    EXPECT_EQ(t.height, 1u);
+    EXPECT_NEAR(environment_density(t, 0, 0), 1.0f, 1e-5f);
+}
+
+} // namespace
+} // namespace nbvh::render

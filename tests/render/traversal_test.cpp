@@ -1,0 +1,96 @@
+// GPU traversal (passes/traverse.comp on lavapipe, validation on) against the CPU traversal
+// (engine/bvh/scene_accel.h) for random rays on real scenes: same hit/miss, instance, triangle and t.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "engine/bvh/scene_accel.h"
+#include "engine/render/wavefront.h"
+#include "engine/scene/gltf_loader.h"
+#include "engine/vk/context.h"
+#include "tests/render/test_scenes.h"
+#include "tests/support/test_support.h"
+
+namespace nbvh::render {
+namespace {
+
+vk::Context make_lavapipe() {
+    vk::ContextOptions o;
+    o.device = vk::DeviceChoice::cpu;
+    o.validation = true;
+    return vk::Context(o);
+}
+
+// Rays from a sphere around the scene towards random points inside its bounds (most hit), plus
+// some in uniformly random directions.
+void make_rays(const Aabb& b, size_t n, uint32_t seed, std::vector<glm::vec3>& org, std::vector<glm::vec3>& dir) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const glm::vec3 c = b.center();
+    const float r = 0.75f * glm::length(b.extent()) + 1e-3f;
+    for (size_t i = 0; i < n; ++i) {
+        glm::vec3 d;
+        do d = glm::vec3(u(rng), u(rng), u(rng)) * 2.0f - 1.0f; while (glm::dot(d, d) > 1.0f || glm::dot(d, d) < 1e-4f);
+        const glm::vec3 o = c + glm::normalize(d) * r;
+        glm::vec3 target = b.lo + glm::vec3(u(rng), u(rng), u(rng)) * b.extent();
+        glm::vec3 dd = (i % 8 == 7) ? glm::normalize(d) : glm::normalize(target - o);
+        org.push_back(o);
+        dir.push_back(dd);
+    }
+}
+
+void compare_with_cpu(const Scene& scene, size_t ray_count, double min_agreement) {
+    vk::Context ctx = make_lavapipe();
+    const SceneAccel accel = build_scene_accel(scene);
+    RenderOptions opt;
+    opt.width = 64;
+    opt.height = 32;
+    WavefrontRenderer renderer(ctx, scene, accel, Environment{}, scene.camera, opt);
+    std::vector<glm::vec3> org, dir;
+    make_rays(scene.world_bounds(), ray_count, 1234u, org, dir);
+    const std::vector<TraceHit> gpu = renderer.trace(org, dir);
+    ASSERT_EQ(gpu.size(), ray_count);
+    const float scale = glm::length(scene.world_bounds().extent());
+    size_t agree = 0, hits = 0;
+    for (size_t i = 0; i < ray_count; ++i) {
+        SceneHit cpu;
+        const bool cpu_hit = intersect_closest(accel, Ray{org[i], dir[i]}, 0.0f, NB_INF, cpu);
+        const bool gpu_hit = gpu[i].instance != 0xFFFFFFFFu;
+        hits += cpu_hit;
+        if (cpu_hit != gpu_hit) continue;
+        if (!cpu_hit) { ++agree; continue; }
+        // Same triangle, or (ties on shared edges) the same distance.
+        const bool same_prim = cpu.instance == gpu[i].instance && cpu.triangle == gpu[i].triangle;
+        if (std::abs(cpu.t - gpu[i].t) <= 1e-5f * scale && (same_prim || std::abs(cpu.t - gpu[i].t) <= 1e-6f * scale))
+            ++agree;
+        if (same_prim) EXPECT_NEAR(cpu.t, gpu[i].t, 1e-5f * scale) << "ray " << i;
+    }
+    EXPECT_GT(hits, ray_count / 2) << "the test rays should mostly hit";
+    EXPECT_GE(double(agree), min_agreement * double(ray_count)) << agree << " of " << ray_count << " agree";
+    EXPECT_EQ(ctx.validation_message_count(), 0);
+}
+
+TEST(GpuTraversal, MatchesCpuOnQuad) {
+    Scene s = test::make_quad_scene();
+    compare_with_cpu(s, 512, 0.999);
+}
+
+TEST(GpuTraversal, MatchesCpuOnStanfordBunny) {
+    NBVH_REQUIRE_SHARED();
+    SceneLoadOptions lo;
+    lo.keep_textures = false;
+    const Scene s = load_gltf(test::scenes_dir() / "stanford_bunny" / "stanford_bunny.glb", lo);
+    compare_with_cpu(s, 2048, 0.995);
+}
+
+TEST(GpuTraversal, MatchesCpuOnFlightHelmet) {
+    NBVH_REQUIRE_SHARED();
+    SceneLoadOptions lo;
+    lo.keep_textures = false;
+    const Scene s = load_gltf(test::scenes_dir() / "flight_helmet" / "FlightHelmet.gltf", lo);
+    compare_with_cpu(s, 2048, 0.995);
+}
+
+} // namespace
+} // namespace nbvh::render
