@@ -92,3 +92,47 @@ TEST(Adam, ExponentialDecaySchedule) {
     cfg.decay_end = 12000;
     EXPECT_NEAR(lr_at_step(cfg, 50000), 1e-2f * 0.33f * 0.33f, 1e-9f);
 }
+
+#include "engine/neural/losses.h"
+
+TEST(Adam, FewStepsOnAFixedBatchReduceTheCompositeLoss) {
+    // Sign conventions end to end: loss gradient (post-sigmoid) -> backward -> Adam must descend.
+    nbvh::NeuralConfig cfg;
+    cfg.log2_hash_size = 14;
+    NetworkWeights w = create_network(cfg, 11);
+    std::vector<SegmentQuery> qs(64);
+    std::vector<Targets> ts(qs.size());
+    for (size_t i = 0; i < qs.size(); ++i) {
+        const float a = float(i) / float(qs.size());
+        qs[i].points = {vec3(a, 0.2f, 0.3f), vec3(0.5f, a, 0.5f), vec3(1.0f - a, 0.8f, 0.7f)};
+        const bool hit = (i % 3) != 0;
+        ts[i] = make_targets(hit, a, normalize(vec3(a - 0.5f, 1.0f, 0.2f)), vec3(a, 0.5f, 1.0f - a));
+    }
+    AdamConfig acfg;
+    Adam adam(acfg, w.mlp.size(), w.grid.size());
+    const LossConfig lcfg;
+    auto total_loss = [&](std::vector<Outputs>* grads) {
+        std::vector<Outputs> y(qs.size());
+        forward_batch(w, qs, Precision::fp32, y, 1);
+        double l = 0;
+        for (size_t i = 0; i < qs.size(); ++i) {
+            Outputs g{};
+            l += composite_loss(y[i], ts[i], lcfg, &g);
+            if (grads) {
+                for (float& v : g) v /= float(qs.size());
+                (*grads)[i] = g;
+            }
+        }
+        return l / double(qs.size());
+    };
+    const double l0 = total_loss(nullptr);
+    std::vector<Outputs> dl(qs.size());
+    std::vector<float> gm, gg;
+    for (int step = 0; step < 30; ++step) {
+        total_loss(&dl);
+        backward_batch(w, qs, dl, gm, gg, 1);
+        adam.step(w, gm, gg);
+    }
+    const double l1 = total_loss(nullptr);
+    EXPECT_LT(l1, 0.5 * l0) << "loss " << l0 << " -> " << l1;
+}
