@@ -17,12 +17,26 @@
 #include "../shared/bvh_node.h"
 #include "../shared/hashgrid.h"
 #include "../shared/neural_query.h"
+#include "../shared/scene_gpu.h"
+#include "../shared/wavefront_gpu.h"
 
 // --- every struct (name, binding in layout.comp) ------------------------------------------------
 #define NB_LAYOUT_STRUCTS(S) \
     S(GpuBvhNode, 0)         \
     S(GpuHashLevel, 1)       \
-    S(GpuEncodingBox, 2)
+    S(GpuEncodingBox, 2)     \
+    S(GpuInstance, 3)        \
+    S(GpuTriangle, 4)        \
+    S(GpuVertex, 5)          \
+    S(GpuTexRef, 6)          \
+    S(GpuMaterial, 7)        \
+    S(GpuTextureInfo, 8)     \
+    S(GpuLight, 9)           \
+    S(GpuFrameParams, 10)    \
+    S(GpuPendingLeaf, 11)    \
+    S(GpuDispatchArgs, 12)   \
+    S(GpuQueueCounters, 13)  \
+    S(GpuPassConstants, 14)
 
 // --- field lists ---------------------------------------------------------------------------------
 #define NB_LAYOUT_FIELDS_GpuBvhNode(F) \
@@ -31,6 +45,36 @@
     F(offset) F(size) F(resolution) F(scale) F(hashed) F(pad0) F(pad1) F(pad2)
 #define NB_LAYOUT_FIELDS_GpuEncodingBox(F) \
     F(center) F(depth_pad) F(extent) F(fixed_depth_eps)
+#define NB_LAYOUT_FIELDS_GpuInstance(F)                                                           \
+    F(object_to_world[0]) F(object_to_world[1]) F(object_to_world[2])                             \
+    F(world_to_object[0]) F(world_to_object[1]) F(world_to_object[2])                             \
+    F(blas_root) F(first_triangle) F(kind) F(mesh)
+#define NB_LAYOUT_FIELDS_GpuTriangle(F) F(v0) F(v1) F(v2) F(material)
+#define NB_LAYOUT_FIELDS_GpuVertex(F) F(position) F(u0) F(normal) F(v0) F(tangent) F(uv1)
+#define NB_LAYOUT_FIELDS_GpuTexRef(F) F(texture) F(uv_set) F(row0) F(row1)
+#define NB_LAYOUT_TEXREF(F, t) F(t.texture) F(t.uv_set) F(t.row0) F(t.row1)
+#define NB_LAYOUT_FIELDS_GpuMaterial(F)                                                           \
+    F(base_color) F(emissive) F(metallic) F(roughness) F(normal_scale) F(alpha_cutoff)            \
+    F(transmission) F(alpha_mode) F(double_sided) F(pad0) F(pad1)                                \
+    NB_LAYOUT_TEXREF(F, base_color_tex) NB_LAYOUT_TEXREF(F, metallic_roughness_tex)              \
+    NB_LAYOUT_TEXREF(F, normal_tex) NB_LAYOUT_TEXREF(F, emissive_tex)
+#define NB_LAYOUT_FIELDS_GpuTextureInfo(F) F(offset) F(width) F(height) F(pad)
+#define NB_LAYOUT_FIELDS_GpuLight(F) F(p0) F(instance) F(p1) F(triangle) F(p2) F(area)
+#define NB_LAYOUT_FIELDS_GpuFrameParams(F)                                                        \
+    F(cam_eye) F(cam_tan_half_fov) F(cam_forward) F(aspect) F(cam_right) F(width) F(cam_up)       \
+    F(height) F(env_width) F(env_height) F(env_intensity) F(env_rotation) F(env_inv_mean)         \
+    F(light_count) F(light_total_power) F(max_depth) F(rr_start_depth) F(seed) F(spp)             \
+    F(wave_capacity) F(ray_epsilon) F(instance_count) F(pad0) F(pad1)
+#define NB_LAYOUT_FIELDS_GpuPendingLeaf(F) F(ray) F(instance) F(leaf) F(t_enter) F(t_exit)
+#define NB_LAYOUT_FIELDS_GpuDispatchArgs(F) F(x) F(y) F(z)
+#define NB_LAYOUT_FIELDS_GpuQueueCounters(F)                                                      \
+    F(ray_dispatch.x) F(ray_dispatch.y) F(ray_dispatch.z)                                         \
+    F(shadow_dispatch.x) F(shadow_dispatch.y) F(shadow_dispatch.z)                                \
+    F(pending_dispatch.x) F(pending_dispatch.y) F(pending_dispatch.z)                             \
+    F(ray_count0) F(ray_count1) F(shadow_count) F(pending_count) F(rays_primary)                  \
+    F(rays_secondary) F(rays_shadow) F(nonfinite_samples)
+#define NB_LAYOUT_FIELDS_GpuPassConstants(F)                                                      \
+    F(in_queue) F(depth) F(sample_index) F(pixel_offset) F(pixel_count) F(mode)
 
 // --- distinct, exactly representable, non-zero values ------------------------------------------
 // Field number k gets base value 16k (+1 for each further component), so every 4-byte word of a
