@@ -25,10 +25,6 @@ inline int wrap(int i, int n) {
 
 } // namespace
 
-float srgb_to_linear(float c) {
-    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
-
 glm::vec4 sample_texture_bilinear(const Texture& texture, glm::vec2 uv, bool srgb) {
     const int w = int(texture.width), h = int(texture.height);
     if (w <= 0 || h <= 0 || texture.rgba8.size() < size_t(w) * size_t(h) * 4u) return glm::vec4(1.0f);

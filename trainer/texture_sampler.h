@@ -5,6 +5,7 @@
 #pragma once
 #include <glm/glm.hpp>
 
+#include "engine/core/image.h"
 #include "engine/scene/scene.h"
 
 namespace nbvh {
@@ -17,6 +18,6 @@ glm::vec4 sample_texture_bilinear(const Texture& texture, glm::vec2 uv, bool srg
 glm::vec4 sample_texture_ref(const std::vector<Texture>& textures, const TextureRef& ref, glm::vec2 uv, bool srgb,
                              glm::vec4 fallback);
 
-float srgb_to_linear(float c);
+// srgb_to_linear(): engine/core/image.h (one definition for the whole project).
 
 } // namespace nbvh
