@@ -25,6 +25,8 @@ NeuralModel make_neural_model(const TrainingAsset& asset, const TrainResult& res
     meta.backend = result.backend;
     meta.source = source;
     meta.source_hash = source_hash;
+    meta.source_triangles = asset.triangle_count();
+    meta.source_vertices = asset.mesh ? asset.mesh->positions.size() : 0;
     meta.created_unix = int64_t(std::time(nullptr));
     const SplitSchedule s = make_split_schedule(options);
     meta.splitting_interval = s.splitting_interval;

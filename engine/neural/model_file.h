@@ -30,6 +30,8 @@ struct TrainingMetadata {
     std::string backend;             // "cpu", "cuda", ...
     std::string source;              // scene file it was trained from (as given)
     uint64_t source_hash = 0;        // fnv1a64 of the glTF file bytes (or of the mesh data)
+    uint64_t source_triangles = 0;   // triangles of the asset the model replaces (0: unknown)
+    uint64_t source_vertices = 0;    // its vertices (0: unknown)
     int64_t created_unix = 0;        // seconds since 1970 (UTC)
     // The split schedule that made the cut (trainer/split_scheduler.h SplitSchedule).
     uint32_t splitting_interval = 0, last_split_iteration = 0, start_split_num = 0;

@@ -199,6 +199,7 @@ std::vector<Section> encode_sections(const NeuralModel& m) {
         const TrainingMetadata& t = m.meta;
         w.u64(t.steps); w.f64(t.seconds); w.f32(t.final_loss); w.u32(t.batch_size);
         w.u64(t.source_hash); w.i64(t.created_unix);
+        w.u64(t.source_triangles); w.u64(t.source_vertices);
         w.u32(t.splitting_interval); w.u32(t.last_split_iteration); w.u32(t.start_split_num);
         w.f32(t.split_scaling); w.f32(t.split_interval_scaling);
         w.str(t.backend);
@@ -332,6 +333,7 @@ NeuralModel decode_sections(const std::vector<SectionView>& sections, const std:
         TrainingMetadata& t = m.meta;
         t.steps = r.u64(); t.seconds = r.f64(); t.final_loss = r.f32(); t.batch_size = r.u32();
         t.source_hash = r.u64(); t.created_unix = r.i64();
+        t.source_triangles = r.u64(); t.source_vertices = r.u64();
         t.splitting_interval = r.u32(); t.last_split_iteration = r.u32(); t.start_split_num = r.u32();
         t.split_scaling = r.f32(); t.split_interval_scaling = r.f32();
         t.backend = r.str("backend");

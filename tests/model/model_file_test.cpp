@@ -70,6 +70,8 @@ TEST(ModelFile, RoundTrip) {
     EXPECT_EQ(b.meta.source, "scenes/tiny.gltf");
     EXPECT_EQ(b.meta.source_hash, 0x0123456789abcdefull);
     EXPECT_EQ(b.meta.created_unix, 1718000000);
+    EXPECT_EQ(b.meta.source_triangles, 1000u);
+    EXPECT_EQ(b.meta.source_vertices, 600u);
     EXPECT_EQ(b.meta.split_scaling, 2.5f);
     EXPECT_EQ(b.tree().node_count_at(1), 3u);
 }
@@ -109,8 +111,8 @@ TEST(ModelFile, GoldenBytes) {
     // at every LoD), flags 0, padding.
     const uint32_t node_head[2 + 10] = {5, 0, 0, 0, 0, 0x3f800000u, 0x3f800000u, 0x3f800000u, 1, 0, 0xFFu, 0};
     EXPECT_EQ(std::memcmp(b.data() + section_offset(b, "NODE"), node_head, sizeof(node_head)), 0);
-    EXPECT_EQ(b.size(), 40896u);
-    EXPECT_EQ(fnv1a64(b.data(), b.size()), 0xae424fd8b015e103ull) << std::hex << fnv1a64(b.data(), b.size());
+    EXPECT_EQ(b.size(), 40912u);
+    EXPECT_EQ(fnv1a64(b.data(), b.size()), 0x72109c6f7a43444cull) << std::hex << fnv1a64(b.data(), b.size());
 }
 
 TEST(ModelFile, TruncationAnywhereIsRejected) {
@@ -217,6 +219,7 @@ TEST(ModelFile, BadContentIsRejected) {
     expect_rejected(edited("ASST", 12, 0.0f), "encoding box has no volume");
     expect_rejected(edited("ASST", 28, uint8_t(27)), "control character"); // ESC in the name
     expect_rejected(edited("META", 8, -1.0), "non-finite or negative");
+    expect_rejected(edited("META", 76, uint32_t(0xFFFF)), "backend length");
     expect_rejected(edited("CONF", 24, uint32_t(32)), "unsupported mlp_width 32");
 }
 

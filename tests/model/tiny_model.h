@@ -43,6 +43,8 @@ inline NeuralModel make_tiny_model() {
     m.meta.source = "scenes/tiny.gltf";
     m.meta.source_hash = 0x0123456789abcdefull;
     m.meta.created_unix = 1718000000;
+    m.meta.source_triangles = 1000;
+    m.meta.source_vertices = 600;
     m.meta.splitting_interval = 40;
     m.meta.last_split_iteration = 3000;
     m.meta.start_split_num = 1;
