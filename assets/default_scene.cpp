@@ -7,10 +7,7 @@
 
 #include "assets/procedural_mesh.h"
 #include "assets/rope_knot.h"
-#if __has_include("engine/scene/environment.h")
 #include "engine/scene/environment.h" // nbvh::default_sky()
-#define NBVH_ASSETS_HAVE_DEFAULT_SKY 1
-#endif
 
 namespace nbvh::assets {
 namespace {
@@ -117,11 +114,7 @@ Scene make_default_scene() {
     s.camera.yfov = 0.75f; // ~43 degrees
     s.has_camera = true;
 
-#ifdef NBVH_ASSETS_HAVE_DEFAULT_SKY
     s.environment = default_sky();
-#else
-    s.environment.constant = glm::vec3(0.6f, 0.7f, 0.9f); // until the scene library's sky is available
-#endif
     return s;
 }
 
