@@ -135,33 +135,52 @@ private:
         return true;
     }
 
-    // Bin index of a centroid along `axis` (same formula for binning and partitioning).
-    uint32_t bin_of(const glm::vec3& c, int axis, float lo, double scale) const {
-        double b = (double(c[axis]) - lo) * scale;
-        return uint32_t(std::clamp(b, 0.0, double(bins_ - 1)));
+    // Bin index of a centroid along `axis` (same formula for binning and partitioning). `scale` is
+    // finite; a product overflowing to +inf is clamped to the last bin.
+    uint32_t bin_of(const glm::vec3& c, int axis, float lo, float scale) const {
+        float b = (c[axis] - lo) * scale;
+        return b >= float(bins_ - 1) ? bins_ - 1 : (b > 0.0f ? uint32_t(b) : 0u);
     }
 
-    Split find_sah_split(const Aabb& nb, const Aabb& cb, uint32_t first, uint32_t count) const {
+    // bins / centroid extent along `axis`, or 0 when the axis cannot be binned.
+    float bin_scale(const Aabb& cb, int axis) const {
+        const float extent = cb.hi[axis] - cb.lo[axis];
+        if (!(extent > 0.0f)) return 0.0f;
+        const float scale = float(bins_) / extent;
+        return std::isfinite(scale) ? scale : 0.0f;
+    }
+
+    Split find_sah_split(const Aabb& nb, const Aabb& cb, uint32_t first, uint32_t count) {
         Split best;
         const bool flat2 = half_area(nb) <= 0.0;
         auto measure = [flat2](const Aabb& b) { return flat2 ? half_perimeter(b) : half_area(b); };
         const double parent = measure(nb);
         if (!(parent > 0.0)) return best; // a point: every centroid is identical anyway
-        std::array<Bin, MAX_BINS> bins;
+        float scale[3];
+        bool any_axis = false;
+        for (int axis = 0; axis < 3; ++axis) {
+            scale[axis] = bin_scale(cb, axis);
+            any_axis |= scale[axis] > 0.0f;
+            for (uint32_t b = 0; b < bins_; ++b) bins_of_[axis][b] = Bin{};
+        }
+        if (!any_axis) return best;
+        // One pass over the primitives fills the bins of all three axes.
+        for (uint32_t i = first; i < first + count; ++i) {
+            const uint32_t p = idx_[i];
+            const glm::vec3& c = centroids_[p];
+            const Aabb& pb = bounds_[p];
+            for (int axis = 0; axis < 3; ++axis) {
+                if (scale[axis] == 0.0f) continue;
+                Bin& bin = bins_of_[axis][bin_of(c, axis, cb.lo[axis], scale[axis])];
+                bin.bounds.grow(pb);
+                ++bin.count;
+            }
+        }
         std::array<double, MAX_BINS> right_measure;
         std::array<uint32_t, MAX_BINS> right_count;
         for (int axis = 0; axis < 3; ++axis) {
-            const double extent = double(cb.hi[axis]) - cb.lo[axis];
-            if (!(extent > 0.0)) continue;
-            const double scale = double(bins_) / extent;
-            if (!std::isfinite(scale)) continue;
-            for (uint32_t b = 0; b < bins_; ++b) bins[b] = Bin{};
-            for (uint32_t i = first; i < first + count; ++i) {
-                uint32_t p = idx_[i];
-                Bin& bin = bins[bin_of(centroids_[p], axis, cb.lo[axis], scale)];
-                bin.bounds.grow(bounds_[p]);
-                ++bin.count;
-            }
+            if (scale[axis] == 0.0f) continue;
+            const std::array<Bin, MAX_BINS>& bins = bins_of_[axis];
             // Sweep from the right, then from the left evaluating "split before bin b".
             Aabb acc;
             uint32_t n = 0;
@@ -185,7 +204,7 @@ private:
     }
 
     uint32_t partition_by_bin(const Aabb& cb, const Split& s, uint32_t first, uint32_t count) {
-        const double scale = double(bins_) / (double(cb.hi[s.axis]) - cb.lo[s.axis]);
+        const float scale = bin_scale(cb, s.axis);
         const float lo = cb.lo[s.axis];
         uint32_t* mid = std::partition(idx_ + first, idx_ + first + count, [&](uint32_t p) {
             return bin_of(centroids_[p], s.axis, lo, scale) < s.bin;
@@ -207,6 +226,7 @@ private:
 
     std::span<const Aabb> bounds_;
     std::vector<glm::vec3> centroids_;
+    std::array<std::array<Bin, MAX_BINS>, 3> bins_of_;
     uint32_t* idx_ = nullptr;
     std::vector<BvhNode>* nodes_ = nullptr;
     uint32_t max_leaf_ = 4, bins_ = 16;
