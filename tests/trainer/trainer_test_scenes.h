@@ -1,0 +1,72 @@
+// Small synthetic neural assets for the trainer tests (built in memory, no files).
+#pragma once
+#include <cmath>
+
+#include <glm/glm.hpp>
+
+#include "engine/scene/scene.h"
+
+namespace nbvh::test {
+
+// A scene with one neural instance of `mesh` and one material of base colour `albedo`.
+inline Scene scene_of(Mesh mesh, glm::vec3 albedo = glm::vec3(0.8f, 0.4f, 0.2f)) {
+    Scene s;
+    mesh.triangle_material.assign(mesh.triangle_count(), 0u);
+    s.meshes.push_back(std::move(mesh));
+    Material m;
+    m.base_color = glm::vec4(albedo, 1.0f);
+    s.materials.push_back(m);
+    Instance inst;
+    inst.mesh = 0;
+    inst.neural = true;
+    inst.name = "asset";
+    s.instances.push_back(inst);
+    return s;
+}
+
+inline void add_quad(Mesh& m, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 n) {
+    const uint32_t base = uint32_t(m.positions.size());
+    for (glm::vec3 p : {a, b, c, d}) {
+        m.positions.push_back(p);
+        m.normals.push_back(n);
+    }
+    for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + i);
+}
+
+// A height field z = amp * sin(x) cos(y) over [0,1]^2 in n x n quads, scaled by `scale` and moved
+// by `offset`. amp = 0 gives a flat asset (zero extent along z).
+inline Mesh height_field(uint32_t n, float amp, float scale, glm::vec3 offset) {
+    Mesh m;
+    m.name = "height_field";
+    auto z = [&](float x, float y) { return amp * std::sin(6.0f * x) * std::cos(5.0f * y); };
+    for (uint32_t j = 0; j <= n; ++j)
+        for (uint32_t i = 0; i <= n; ++i) {
+            const float x = float(i) / float(n), y = float(j) / float(n);
+            m.positions.push_back(offset + scale * glm::vec3(x, y, z(x, y)));
+            const glm::vec3 dx(1.0f, 0.0f, amp * 6.0f * std::cos(6.0f * x) * std::cos(5.0f * y));
+            const glm::vec3 dy(0.0f, 1.0f, -amp * 5.0f * std::sin(6.0f * x) * std::sin(5.0f * y));
+            m.normals.push_back(glm::normalize(glm::cross(dx, dy)));
+        }
+    for (uint32_t j = 0; j < n; ++j)
+        for (uint32_t i = 0; i < n; ++i) {
+            const uint32_t a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
+            for (uint32_t k : {a, b, d, a, d, c}) m.indices.push_back(k);
+        }
+    return m;
+}
+
+// An axis-aligned unit cube [0,1]^3 * scale + offset, 12 triangles, outward normals.
+inline Mesh cube(float scale = 1.0f, glm::vec3 offset = glm::vec3(0.0f)) {
+    Mesh m;
+    m.name = "cube";
+    auto P = [&](float x, float y, float z) { return offset + scale * glm::vec3(x, y, z); };
+    add_quad(m, P(0, 0, 0), P(0, 1, 0), P(1, 1, 0), P(1, 0, 0), {0, 0, -1});
+    add_quad(m, P(0, 0, 1), P(1, 0, 1), P(1, 1, 1), P(0, 1, 1), {0, 0, 1});
+    add_quad(m, P(0, 0, 0), P(1, 0, 0), P(1, 0, 1), P(0, 0, 1), {0, -1, 0});
+    add_quad(m, P(0, 1, 0), P(0, 1, 1), P(1, 1, 1), P(1, 1, 0), {0, 1, 0});
+    add_quad(m, P(0, 0, 0), P(0, 0, 1), P(0, 1, 1), P(0, 1, 0), {-1, 0, 0});
+    add_quad(m, P(1, 0, 0), P(1, 1, 0), P(1, 1, 1), P(1, 0, 1), {1, 0, 0});
+    return m;
+}
+
+} // namespace nbvh::test

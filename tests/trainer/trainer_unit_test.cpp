@@ -1,0 +1,213 @@
+// Unit tests of the trainer's pieces: ray/box clipping, first leaf of a cut, survival roulette,
+// ground truth, texture fetch, schedule sizing, CSV log.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "tests/support/test_support.h"
+#include "tests/trainer/trainer_test_scenes.h"
+#include "trainer/cpu/cpu_backend.h"
+#include "trainer/ground_truth.h"
+#include "trainer/texture_sampler.h"
+#include "trainer/trainer.h"
+
+using namespace nbvh;
+
+TEST(TrainingRays, ClipLineToBox) {
+    const Aabb box{glm::vec3(0.0f), glm::vec3(1.0f)};
+    float t0, t1;
+    ASSERT_TRUE(clip_line_to_box({-1.0f, 0.5f, 0.5f}, {1, 0, 0}, box, t0, t1));
+    EXPECT_FLOAT_EQ(t0, 1.0f);
+    EXPECT_FLOAT_EQ(t1, 2.0f);
+    // Origin inside: entry behind the origin (mint = -inf).
+    ASSERT_TRUE(clip_line_to_box({0.25f, 0.5f, 0.5f}, {1, 0, 0}, box, t0, t1));
+    EXPECT_FLOAT_EQ(t0, -0.25f);
+    EXPECT_FLOAT_EQ(t1, 0.75f);
+    // Parallel to a slab with the origin exactly on a face: inside, finite interval, no NaN.
+    ASSERT_TRUE(clip_line_to_box({0.0f, 0.0f, -2.0f}, {0, 0, 1}, box, t0, t1));
+    EXPECT_FLOAT_EQ(t0, 2.0f);
+    EXPECT_FLOAT_EQ(t1, 3.0f);
+    // Parallel and outside.
+    EXPECT_FALSE(clip_line_to_box({1.5f, 0.5f, -2.0f}, {0, 0, 1}, box, t0, t1));
+    // Flat box (zero extent in z): an oblique ray gets a zero-length, finite interval.
+    const Aabb flat{glm::vec3(0.0f), glm::vec3(1.0f, 1.0f, 0.0f)};
+    ASSERT_TRUE(clip_line_to_box({0.5f, 0.5f, 1.0f}, glm::normalize(glm::vec3(0.1f, 0.1f, -1.0f)), flat, t0, t1));
+    EXPECT_TRUE(std::isfinite(t0) && std::isfinite(t1));
+    EXPECT_NEAR(t0, t1, 1e-6f);
+    EXPECT_FALSE(clip_line_to_box({0, 0, 0}, {1, 0, 0}, Aabb{}, t0, t1)); // empty box
+}
+
+TEST(TrainingRays, UniformDirectionsAreUnit) {
+    Pcg32 rng(1, 2);
+    glm::vec3 mean(0.0f);
+    for (int i = 0; i < 20000; ++i) {
+        const glm::vec3 d = uniform_sphere_direction(rng.next_float(), rng.next_float());
+        ASSERT_NEAR(glm::length(d), 1.0f, 1e-5f);
+        mean += d / 20000.0f;
+    }
+    EXPECT_LT(glm::length(mean), 0.03f); // no bias towards a hemisphere
+}
+
+namespace {
+// Two cubes far apart: the root's children are the two cubes (after enough splits).
+Scene two_cubes() {
+    Mesh m = test::cube(1.0f, glm::vec3(0.0f));
+    const Mesh b = test::cube(1.0f, glm::vec3(4.0f, 0.0f, 0.0f));
+    const uint32_t off = uint32_t(m.positions.size());
+    m.positions.insert(m.positions.end(), b.positions.begin(), b.positions.end());
+    m.normals.insert(m.normals.end(), b.normals.begin(), b.normals.end());
+    for (uint32_t i : b.indices) m.indices.push_back(i + off);
+    return test::scene_of(m);
+}
+} // namespace
+
+TEST(TrainingRays, FirstLeafOfCutIsTheNearest) {
+    const Scene scene = two_cubes();
+    const TrainingAsset asset = make_training_asset(scene, 0);
+    const Bvh& bvh = asset.bvh();
+    ASSERT_FALSE(bvh.nodes[0].is_leaf());
+    TrainingCut cut;
+    const uint32_t kids[2] = {bvh.nodes[0].left, bvh.nodes[0].right};
+    cut.assign(kids, bvh.nodes.size());
+    // Which child holds the cube at x = 0?
+    const int near_slot = asset.node_boxes[kids[0]].hi.x < 2.0f ? 0 : 1;
+    FirstLeaf f = first_leaf_of_cut(bvh, asset.node_boxes, cut, {-2.0f, 0.5f, 0.5f}, {1, 0, 0}, 1e-5f, asset.min_exit);
+    EXPECT_EQ(f.leaf, near_slot);
+    EXPECT_NEAR(f.t_entry, 2.0f, 1e-3f);
+    f = first_leaf_of_cut(bvh, asset.node_boxes, cut, {7.0f, 0.5f, 0.5f}, {-1, 0, 0}, 1e-5f, asset.min_exit);
+    EXPECT_EQ(f.leaf, 1 - near_slot);
+    // Origin inside the far cube, looking back: the leaf containing the origin comes first (t_entry < 0).
+    f = first_leaf_of_cut(bvh, asset.node_boxes, cut, {4.5f, 0.5f, 0.5f}, {-1, 0, 0}, 1e-5f, asset.min_exit);
+    EXPECT_EQ(f.leaf, 1 - near_slot);
+    EXPECT_LT(f.t_entry, 0.0f);
+    // Pointing away from everything.
+    f = first_leaf_of_cut(bvh, asset.node_boxes, cut, {-2.0f, 0.5f, 0.5f}, {0, 1, 0}, 1e-5f, asset.min_exit);
+    EXPECT_EQ(f.leaf, -1);
+}
+
+TEST(TrainingRays, SurvivalRouletteRedrawsRejectedSamples) {
+    const Scene scene = two_cubes();
+    const TrainingAsset asset = make_training_asset(scene, 0);
+    const Bvh& bvh = asset.bvh();
+    TrainingCut cut;
+    const uint32_t kids[2] = {bvh.nodes[0].left, bvh.nodes[0].right};
+    cut.assign(kids, bvh.nodes.size());
+    cut.keep_probability = {0.0f, 1.0f}; // leaf 0 is always rejected
+    const TrainingCut* cuts[1] = {&cut};
+    Pcg32 rng(7, 1);
+    uint32_t draws_per_leaf[2] = {0, 0};
+    uint64_t draws = 0;
+    for (int i = 0; i < 2000; ++i) {
+        const TrainingSample s = draw_training_sample(asset, cuts, rng, draws_per_leaf, draws);
+        ASSERT_EQ(s.leaf, 1);
+        ASSERT_TRUE(std::isfinite(s.length) && s.length >= 0.0f);
+    }
+    EXPECT_GT(draws_per_leaf[0], 100u); // rejected draws still count towards p
+    EXPECT_EQ(draws_per_leaf[1], 2000u);
+    EXPECT_GT(draws, 4000u);
+}
+
+TEST(GroundTruth, QuadHitDepthNormalAlbedo) {
+    Mesh m;
+    test::add_quad(m, {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1});
+    const Scene scene = test::scene_of(m, glm::vec3(0.25f, 0.5f, 0.75f));
+    const TrainingAsset asset = make_training_asset(scene, 0);
+    // Segment from z = 1 to z = -1 through (0.3, 0.6): hit at t = 1 of a length-2 segment.
+    const GroundTruth gt = trace_ground_truth(asset, {0.3f, 0.6f, 1.0f}, {0, 0, -1}, 0.0f, 2.0f);
+    ASSERT_TRUE(gt.hit);
+    EXPECT_NEAR(gt.t_hit, 1.0f, 1e-6f);
+    EXPECT_NEAR(gt.depth, 1.0f / (2.0f + asset.encoding.depth_pad), 1e-6f);
+    EXPECT_NEAR(gt.normal.z, 1.0f, 1e-6f); // not flipped towards the ray
+    EXPECT_NEAR(gt.albedo.x, 0.25f, 1e-6f);
+    EXPECT_NEAR(gt.albedo.z, 0.75f, 1e-6f);
+    // From below: same normal (never flipped).
+    const GroundTruth below = trace_ground_truth(asset, {0.3f, 0.6f, -1.0f}, {0, 0, 1}, 0.0f, 2.0f);
+    ASSERT_TRUE(below.hit);
+    EXPECT_NEAR(below.normal.z, 1.0f, 1e-6f);
+    // Segment that stops before the surface: miss.
+    EXPECT_FALSE(trace_ground_truth(asset, {0.3f, 0.6f, 1.0f}, {0, 0, -1}, 0.0f, 0.5f).hit);
+    // Segment starting behind the origin (t_entry < 0) finds the surface behind it.
+    EXPECT_TRUE(trace_ground_truth(asset, {0.3f, 0.6f, -0.5f}, {0, 0, -1}, -1.0f, 0.2f).hit);
+}
+
+TEST(GroundTruth, TexturedAlbedoIsSrgbDecoded) {
+    Mesh m;
+    test::add_quad(m, {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1});
+    m.uv0 = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    Scene scene = test::scene_of(m, glm::vec3(1.0f));
+    Texture t;
+    t.width = t.height = 1;
+    t.rgba8 = {188, 188, 188, 255}; // sRGB 188/255 ~ linear 0.5
+    t.srgb = true;
+    scene.textures.push_back(t);
+    scene.materials[0].base_color = glm::vec4(0.5f, 1.0f, 1.0f, 1.0f);
+    scene.materials[0].base_color_tex.texture = 0;
+    const TrainingAsset asset = make_training_asset(scene, 0);
+    const GroundTruth gt = trace_ground_truth(asset, {0.3f, 0.6f, 1.0f}, {0, 0, -1}, 0.0f, 2.0f);
+    ASSERT_TRUE(gt.hit);
+    EXPECT_NEAR(gt.albedo.y, 0.5029f, 2e-3f);
+    EXPECT_NEAR(gt.albedo.x, 0.5f * 0.5029f, 2e-3f); // factor x texture
+}
+
+TEST(TextureSampler, BilinearWrap) {
+    Texture t;
+    t.width = 2;
+    t.height = 1;
+    t.rgba8 = {0, 0, 0, 255, 255, 255, 255, 255};
+    // Texel centres.
+    EXPECT_NEAR(sample_texture_bilinear(t, {0.25f, 0.5f}, false).x, 0.0f, 1e-6f);
+    EXPECT_NEAR(sample_texture_bilinear(t, {0.75f, 0.5f}, false).x, 1.0f, 1e-6f);
+    // Halfway between texel 1 and (wrapped) texel 0.
+    EXPECT_NEAR(sample_texture_bilinear(t, {1.0f, 0.5f}, false).x, 0.5f, 1e-6f);
+    EXPECT_NEAR(sample_texture_bilinear(t, {-0.25f, 0.5f}, false).x, 1.0f, 1e-6f); // wrap
+    EXPECT_NEAR(sample_texture_bilinear(t, {0.75f, 0.5f}, true).x, 1.0f, 1e-6f);
+    EXPECT_TRUE(std::isfinite(sample_texture_bilinear(t, {NAN, 1e30f}, true).x));
+}
+
+TEST(Schedule, ReachesTargetNodeCount) {
+    for (uint32_t target : {31u, 200u, 1000u, 2395u}) {
+        TrainOptions o = default_train_options(BackendChoice::cpu);
+        o.target_nodes = target;
+        const SplitSchedule s = make_split_schedule(o);
+        EXPECT_GE(simulate_split_schedule(s).nodes, target) << target;
+        EXPECT_LE(s.last_split_iteration, o.steps);
+    }
+    TrainOptions bad = default_train_options(BackendChoice::cpu);
+    bad.steps = 0;
+    EXPECT_THROW(validate(bad), Error);
+    bad = default_train_options(BackendChoice::cpu);
+    bad.lods = 99;
+    EXPECT_THROW(validate(bad), Error);
+}
+
+TEST(Trainer, GrowsTheCutToTheTargetAndWritesTheLog) {
+    const Scene scene = test::scene_of(test::height_field(16, 0.2f, 1.0f, glm::vec3(0.0f)));
+    const TrainingAsset asset = make_training_asset(scene, 0);
+    TrainOptions o = default_train_options(BackendChoice::cpu);
+    o.steps = 40;
+    o.batch_size = 256;
+    o.target_nodes = 41;
+    o.lods = 2;
+    o.network.log2_hash_size = 10;
+    auto backend = make_backend(BackendChoice::cpu, asset, o);
+    uint32_t progress_calls = 0;
+    const TrainResult r = train_asset(asset, o, *backend, [&](const TrainProgress&) { progress_calls++; });
+    EXPECT_EQ(progress_calls, o.steps);
+    EXPECT_TRUE(r.tree.frozen());
+    EXPECT_LE(r.tree.node_count(), o.target_nodes);
+    EXPECT_GE(r.tree.node_count(), o.target_nodes / 2);
+    EXPECT_LE(r.tree.node_count_at(1), r.tree.node_count_at(0)); // LoD 1 is coarser
+    EXPECT_EQ(r.skipped_steps, 0u);
+    // The learning rate decays in the final stage.
+    EXPECT_LT(r.log.back().learning_rate, r.log.front().learning_rate);
+    const auto path = test::temp_dir("trainer_log") / "log.csv";
+    write_train_log_csv(r.log, path.string());
+    std::ifstream f(path);
+    std::string header;
+    std::getline(f, header);
+    EXPECT_EQ(header.rfind("step,nodes,leaves,lr,loss", 0), 0u);
+    uint32_t lines = 0;
+    for (std::string line; std::getline(f, line);) lines++;
+    EXPECT_EQ(lines, o.steps);
+}
