@@ -1,12 +1,127 @@
-// nbvh render — being written (scaffold from the project skeleton; replaced by its issue's work).
+// nbvh render SCENE [--out FILE.png|.exr] [--width --height --spp --max-depth --seed] [--device]
+//                   [--camera ex,ey,ez,tx,ty,tz,fov] [--env FILE.hdr|.exr] [--stats FILE.json] [--explain]
+// Loads the scene, builds its BVHs, runs the wavefront path tracer (engine/render/) and writes the image
+// (PNG: ACES-fit tone map + sRGB, engine/core/image.h; EXR: linear radiance).
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
 #include "app/commands.h"
+#include "app/scene_arg.h"
+#include "engine/bvh/scene_accel.h"
 #include "engine/core/error.h"
+#include "engine/core/image.h"
+#include "engine/core/log.h"
+#include "engine/render/wavefront.h"
+#include "engine/scene/camera.h"
+#include "engine/scene/environment.h"
+#include "engine/vk/context.h"
 
 namespace nbvh::app {
+namespace {
+
+struct RenderArgs {
+    std::string scene, out = "render.png", device = "auto", camera, env, stats;
+    render::RenderOptions options;
+    bool explain = false;
+};
+
+// The environment to light with: --env, else the scene's, else the default sky when nothing else
+// would light the scene (a glTF without lights would otherwise render black).
+Environment choose_environment(const Scene& scene, const std::string& env_path) {
+    if (!env_path.empty()) return load_environment(env_path);
+    if (!scene.environment.empty()) return scene.environment;
+    const render::SceneFeatures f = render::derive_features(scene, Environment{});
+    if (!f.emission) {
+        log_info("render: the scene has no lights; lighting it with the default sky (use --env to change)");
+        return default_sky();
+    }
+    return Environment{};
+}
+
+void write_stats(const std::string& path, const render::RenderStats& s, const std::string& scene) {
+    nlohmann::json j;
+    j["scene"] = scene;
+    j["device"] = s.device;
+    j["driver"] = s.driver;
+    j["width"] = s.width;
+    j["height"] = s.height;
+    j["spp"] = s.spp;
+    j["max_depth"] = s.max_depth;
+    nlohmann::json passes = nlohmann::json::object();
+    for (const auto& [name, ms] : s.pass_ms) passes[name] = ms;
+    j["pass_gpu_ms"] = passes;
+    j["gpu_total_ms"] = s.gpu_ms;
+    j["wall_ms"] = s.wall_ms;
+    j["rays"] = {{"primary", s.rays_primary}, {"secondary", s.rays_secondary}, {"shadow", s.rays_shadow},
+                 {"total", s.rays_total()}};
+    j["rays_per_second"] = s.rays_per_second();
+    j["non_finite_samples"] = s.nonfinite_samples;
+    j["non_finite_pixels"] = s.nonfinite_pixels;
+    std::ofstream f(path);
+    if (!f) throw Error(strfmt("cannot write stats file '%s'", path.c_str()));
+    f << j.dump(2) << "\n";
+}
+
+void run_render(const RenderArgs& a) {
+    if (!is_png_path(a.out) && !is_exr_path(a.out))
+        throw Error(strfmt("--out '%s': expected a .png or .exr file name", a.out.c_str()));
+    Scene scene = load_scene_arg(a.scene);
+    const Environment env = choose_environment(scene, a.env);
+    const float aspect = float(a.options.width) / float(std::max(1u, a.options.height));
+    const Camera camera = !a.camera.empty() ? parse_camera(a.camera) : scene.has_camera ? scene.camera
+                                                                                         : auto_frame(scene, aspect);
+    if (a.explain) {
+        std::printf("%s", render::explain(render::derive_features(scene, env), a.options.max_depth).c_str());
+        return;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const SceneAccel accel = build_scene_accel(scene);
+    log_info("render: BVHs built in %.1f ms", std::chrono::duration<double, std::milli>(
+                                                  std::chrono::steady_clock::now() - t0).count());
+    vk::ContextOptions copt;
+    copt.device = vk::parse_device_choice(a.device);
+    vk::Context ctx(copt);
+    render::WavefrontRenderer renderer(ctx, scene, accel, env, camera, a.options);
+    render::RenderResult result = renderer.render();
+    const render::RenderStats& s = result.stats;
+    log_info("render: %ux%u, %u spp on %s: %.1f ms GPU, %.3g rays/s, %llu non-finite pixels", s.width, s.height,
+             s.spp, s.device.c_str(), s.gpu_ms, s.rays_per_second(), (unsigned long long)s.nonfinite_pixels);
+    if (is_exr_path(a.out)) {
+        save_exr(a.out, convert_channels(result.image, 3));
+    } else {
+        PngEncode enc;
+        enc.tone_map = ToneMap::aces;
+        save_png(a.out, result.image, enc);
+    }
+    if (!a.stats.empty()) write_stats(a.stats, s, a.scene);
+    if (ctx.validation_enabled() && ctx.validation_message_count() > 0)
+        log_warn("render: %d Vulkan validation messages", ctx.validation_message_count());
+}
+
+} // namespace
 
 void add_render_command(CLI::App& app) {
-    auto* cmd = app.add_subcommand("render", "(not built yet)");
-    cmd->callback([] { throw Error("'nbvh render' is not built yet"); });
+    auto args = std::make_shared<RenderArgs>();
+    auto* cmd = app.add_subcommand("render", "path-trace a glTF scene (or 'default') with the wavefront renderer");
+    cmd->add_option("scene", args->scene, "glTF/GLB file, or 'default' for the built-in scene")->required();
+    cmd->add_option("--out", args->out, "output image: .png (tone-mapped sRGB) or .exr (linear)");
+    cmd->add_option("--width", args->options.width, "image width in pixels")->check(CLI::Range(1u, 16384u));
+    cmd->add_option("--height", args->options.height, "image height in pixels")->check(CLI::Range(1u, 16384u));
+    cmd->add_option("--spp", args->options.spp, "samples per pixel")->check(CLI::Range(1u, 1u << 20));
+    cmd->add_option("--max-depth", args->options.max_depth, "maximum path segments (1 = direct visibility)")
+        ->check(CLI::Range(1u, 256u));
+    cmd->add_option("--seed", args->options.seed, "random seed");
+    cmd->add_option("--device", args->device, "Vulkan device: auto, gpu or cpu (lavapipe)");
+    cmd->add_option("--camera", args->camera, "eye_x,eye_y,eye_z,target_x,target_y,target_z,fov_deg");
+    cmd->add_option("--env", args->env, "environment map (.hdr or .exr, equirectangular)");
+    cmd->add_option("--stats", args->stats, "write per-pass GPU times, ray counts and checks as JSON");
+    cmd->add_flag("--explain", args->explain, "print the scene's feature set and the passes, then exit");
+    cmd->callback([args] { run_render(*args); });
 }
 
 } // namespace nbvh::app
