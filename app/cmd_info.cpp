@@ -1,12 +1,99 @@
-// nbvh info — being written (scaffold from the project skeleton; replaced by its issue's work).
+// nbvh info MODEL: what a .nbvh model holds — hyperparameters, the N-BVH per level of detail, memory of
+// the neural part against the triangles it replaces, and how it was trained.
+#include <cstdio>
+#include <ctime>
+#include <string>
+
 #include "app/commands.h"
 #include "engine/core/error.h"
+#include "engine/core/log.h"
+#include "engine/neural/model_file.h"
 
 namespace nbvh::app {
 
+namespace {
+
+std::string human_bytes(double b) {
+    const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
+    int u = 0;
+    while (b >= 1024.0 && u < 4) { b /= 1024.0; ++u; }
+    return u == 0 ? strfmt("%.0f B", b) : strfmt("%.2f %s", b, units[u]);
+}
+
+std::string utc_date(int64_t unix_seconds) {
+    if (unix_seconds <= 0) return "unknown";
+    const std::time_t t = std::time_t(unix_seconds);
+    std::tm tm{};
+    if (!gmtime_r(&t, &tm)) return "unknown";
+    char buf[64];
+    std::strftime(buf, sizeof(buf), "%Y-%m-%d %H:%M:%S UTC", &tm);
+    return buf;
+}
+
+// Classical representation of the replaced mesh as the renderer holds it: positions, normals and
+// one UV set per vertex (32 B), 3 indices per triangle (12 B), and a BLAS of ~one 64-byte node per
+// triangle (two-child nodes over leaves of up to 2 triangles, rounded up).
+uint64_t classical_bytes(const TrainingMetadata& m) {
+    return m.source_vertices * 32 + m.source_triangles * 12 + m.source_triangles * sizeof(GpuBvhNode);
+}
+
+void print_model(const std::string& path) {
+    const NeuralModel m = load_model(path);
+    const NbvhTree tree = m.tree();
+    const NeuralConfig& c = m.cfg;
+    std::printf("model        %s (format version %u)\n", path.c_str(), MODEL_FORMAT_VERSION);
+    std::printf("asset        %s\n", m.asset_name.empty() ? "(unnamed)" : m.asset_name.c_str());
+    std::printf("encoding box (%g, %g, %g) - (%g, %g, %g)\n", m.encoding_box.lo.x, m.encoding_box.lo.y,
+                m.encoding_box.lo.z, m.encoding_box.hi.x, m.encoding_box.hi.y, m.encoding_box.hi.z);
+    std::printf("hash grid    %u levels x %u features, base resolution %u, per-level scale %g, 2^%u entries per "
+                "hashed level\n", c.grid_levels, c.grid_features, c.base_resolution, double(c.per_level_scale),
+                c.log2_hash_size);
+    for (size_t l = 0; l < m.levels.size(); ++l)
+        std::printf("  level %zu    resolution %5u  %8u entries  %s\n", l, m.levels[l].resolution, m.levels[l].size,
+                    m.levels[l].hashed ? "hashed" : "dense");
+    std::printf("mlp          %u -> %u x %u hidden -> %u outputs, %zu fp16 weights\n",
+                c.segment_points * c.grid_levels * c.grid_features, c.mlp_width, c.mlp_hidden_layers, c.mlp_outputs,
+                m.mlp.size());
+    std::printf("n-bvh        %u nodes, %u leaves, depth %u, %u level%s of detail\n", tree.node_count(),
+                tree.leaf_count(), tree.max_depth(), m.lod_count, m.lod_count == 1 ? "" : "s");
+    for (uint32_t l = 0; l < m.lod_count; ++l) {
+        const uint32_t n = m.lod_node_counts[l];
+        std::printf("  LoD %u      %8u nodes  %8u leaves%s\n", l, n, (n + 1) / 2,
+                    l == 0 ? "  (finest)" : (l + 1 == m.lod_count ? "  (coarsest)" : ""));
+    }
+    const uint64_t nodes_b = uint64_t(m.lod_node_counts[0] / 2 + 1) * sizeof(GpuBvhNode);
+    const uint64_t mlp_b = m.mlp.size() * 2, grid_b = m.grid.size() * 2;
+    const uint64_t neural = model_gpu_bytes(m);
+    std::printf("memory       %s neural (grid %s, mlp %s, nodes %s)\n", human_bytes(double(neural)).c_str(),
+                human_bytes(double(grid_b)).c_str(), human_bytes(double(mlp_b)).c_str(),
+                human_bytes(double(nodes_b)).c_str());
+    if (m.meta.source_triangles > 0) {
+        const uint64_t classic = classical_bytes(m.meta);
+        std::printf("replaces     %llu triangles, %llu vertices: ~%s as mesh + BLAS -> compression %.1fx\n",
+                    (unsigned long long)m.meta.source_triangles, (unsigned long long)m.meta.source_vertices,
+                    human_bytes(double(classic)).c_str(), double(classic) / double(neural));
+    } else {
+        std::printf("replaces     unknown (the model does not record its source mesh size)\n");
+    }
+    const TrainingMetadata& t = m.meta;
+    std::printf("training     %llu steps, batch %u, final loss %g, %.1f s on %s\n", (unsigned long long)t.steps,
+                t.batch_size, double(t.final_loss), t.seconds, t.backend.empty() ? "?" : t.backend.c_str());
+    std::printf("split        interval %u, last split %u, start %u, scaling %g, interval scaling %g\n",
+                t.splitting_interval, t.last_split_iteration, t.start_split_num, double(t.split_scaling),
+                double(t.split_interval_scaling));
+    std::printf("source       %s (fnv1a64 %016llx)\n", t.source.empty() ? "?" : t.source.c_str(),
+                (unsigned long long)t.source_hash);
+    std::printf("created      %s\n", utc_date(t.created_unix).c_str());
+}
+
+} // namespace
+
 void add_info_command(CLI::App& app) {
-    auto* cmd = app.add_subcommand("info", "(not built yet)");
-    cmd->callback([] { throw Error("'nbvh info' is not built yet"); });
+    auto* cmd = app.add_subcommand("info", "Print a .nbvh model: sizes, nodes per LoD, memory vs the mesh it "
+                                           "replaces, training metadata");
+    auto path = std::make_shared<std::string>();
+    cmd->add_option("model", *path, "model file (.nbvh)")->required();
+    cmd->callback([path] { print_model(*path); });
 }
 
 } // namespace nbvh::app
