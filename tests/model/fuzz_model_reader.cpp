@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <random>
+#include <string>
 
 #include "engine/core/error.h"
 #include "engine/neural/model_file.h"
@@ -79,6 +80,11 @@ std::vector<uint8_t> mutate(std::vector<uint8_t> b, std::mt19937& rng) {
 } // namespace
 
 int main(int argc, char** argv) {
+    // `--write-tiny PATH`: save the tiny test model (fixture of the `nbvh info` CLI tests).
+    if (argc == 3 && std::string(argv[1]) == "--write-tiny") {
+        nbvh::save_model(argv[2], nbvh::test::make_tiny_model());
+        return 0;
+    }
     const int iterations = argc > 1 ? std::atoi(argv[1]) : 3000;
     const std::vector<uint8_t> model = nbvh::serialize_model(nbvh::test::make_tiny_model());
     std::vector<uint8_t> official(16 + 3 * 40 + 8, 0);
