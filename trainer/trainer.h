@@ -28,9 +28,9 @@ enum class BackendChoice { cpu, cuda, automatic };
 struct TrainOptions {
     NeuralConfig network;              // network.log2_hash_size is --hash-log2
     uint32_t target_nodes = 1000;      // N-BVH node count at which splitting stops (--nodes)
-    uint32_t steps = 1500;             // total optimiser steps (split stage + final stage)
+    uint32_t steps = 1000;             // total optimiser steps (split stage + final stage)
     float split_fraction = 0.6f;       // share of the steps during which the cut grows
-    uint32_t batch_size = 1u << 12;    // trained samples per step
+    uint32_t batch_size = 1u << 11;    // trained samples per step
     uint32_t lods = 1;                 // cuts kept as levels of detail (paper §3.4)
     uint64_t seed = 1337;
     float learning_rate = 1e-2f;       // Adam (paper §4)
