@@ -20,19 +20,20 @@ namespace {
 struct Rendered {
     RenderResult result;
     int validation = 0;
+    bool validation_enabled = false;
     SceneFeatures features;
 };
 
 Rendered render_small(const Scene& scene, const Environment& env, uint32_t spp = 4, uint32_t max_depth = 3,
-                      uint32_t seed = 1) {
+                      uint32_t seed = 1, uint32_t width = 48, uint32_t height = 32) {
     vk::ContextOptions o;
     o.device = vk::DeviceChoice::cpu;
     o.validation = true;
     vk::Context ctx(o);
     const SceneAccel accel = build_scene_accel(scene);
     RenderOptions opt;
-    opt.width = 48;
-    opt.height = 32;
+    opt.width = width;
+    opt.height = height;
     opt.spp = spp;
     opt.max_depth = max_depth;
     opt.seed = seed;
@@ -43,11 +44,13 @@ Rendered render_small(const Scene& scene, const Environment& env, uint32_t spp =
     out.features = r.features();
     out.result = r.render();
     out.validation = ctx.validation_message_count();
+    out.validation_enabled = ctx.validation_enabled();
     return out;
 }
 
 void expect_sane(const Rendered& r) {
     const Image& img = r.result.image;
+    EXPECT_TRUE(r.validation_enabled) << "the Khronos validation layer must be installed for this test";
     EXPECT_EQ(r.validation, 0);
     EXPECT_EQ(r.result.stats.nonfinite_pixels, 0u);
     EXPECT_EQ(r.result.stats.nonfinite_samples, 0u);
@@ -97,6 +100,22 @@ TEST(Render, EmissiveQuadLightsFloorWithoutEnvironment) {
     EXPECT_TRUE(r.features.emission);
     EXPECT_FALSE(r.features.environment);
     expect_sane(r);
+}
+
+// A rough white-ish dielectric plane under a constant white sky sees the whole upper hemisphere, so its
+// outgoing radiance is its directional albedo: the diffuse 0.8 plus a few percent of GGX specular.
+// Catches NEE/MIS weights that double-count or drop the environment (0.4 or 1.6 instead).
+TEST(Render, PlaneUnderUniformSkyReflectsItsAlbedo) {
+    Scene s = test::make_quad_scene();
+    s.materials[0].roughness = 1.0f;
+    s.camera.yfov = 0.2f; // every pixel sees the quad near its centre
+    const Rendered r = render_small(s, constant_environment(glm::vec3(1.0f)), 64, 2, 3, 8, 8);
+    EXPECT_EQ(r.validation, 0);
+    double mean = 0.0;
+    for (size_t i = 0; i < r.result.image.pixel_count(); ++i) mean += r.result.image.data[i * 4 + 1];
+    mean /= double(r.result.image.pixel_count());
+    EXPECT_GT(mean, 0.78);
+    EXPECT_LT(mean, 0.92);
 }
 
 TEST(Render, SameSeedSameImage) {
