@@ -1,0 +1,192 @@
+#include "engine/render/neural_model_gpu.h"
+
+#include <algorithm>
+
+#include "engine/core/error.h"
+#include "engine/core/log.h"
+#include "engine/vk/commands.h"
+#include "shaders/shared/mlp.h"
+
+namespace nbvh::render {
+
+NeuralPath parse_neural_path(std::string_view text) {
+    if (text == "auto") return NeuralPath::automatic;
+    if (text == "scalar") return NeuralPath::scalar;
+    if (text == "coopmat") return NeuralPath::coopmat;
+    throw Error(strfmt("--neural-path must be auto, scalar or coopmat (got '%.*s')", int(text.size()), text.data()));
+}
+
+const char* neural_path_name(NeuralPath path) {
+    switch (path) {
+    case NeuralPath::automatic: return "auto";
+    case NeuralPath::scalar: return "scalar";
+    case NeuralPath::coopmat: return "coopmat";
+    }
+    return "?";
+}
+
+std::string NeuralKernelChoice::describe() const {
+    if (path == NeuralPath::scalar) return "scalar fp16 (one query per invocation)";
+    return fp32_accumulate ? "cooperative matrix 16x16x16 fp16 -> fp32 (fused, 64 queries per workgroup)"
+                           : "cooperative matrix 16x16x16 fp16 -> fp16 (fused, 64 queries per workgroup)";
+}
+
+namespace {
+bool has_shape(const vk::DeviceFeatures& dev, VkComponentTypeNV acc) {
+    for (const vk::CoopMatrixShape& s : dev.coop_matrix_shapes)
+        if (s.m == 16 && s.n == 16 && s.k == 16 && s.a == VK_COMPONENT_TYPE_FLOAT16_NV &&
+            s.b == VK_COMPONENT_TYPE_FLOAT16_NV && s.c == acc && s.d == acc && s.scope == VK_SCOPE_SUBGROUP_NV)
+            return true;
+    return false;
+}
+} // namespace
+
+std::string coopmat_unavailable_reason(const vk::DeviceFeatures& dev) {
+    if (!dev.coop_matrix_nv) return "the device lacks VK_NV_cooperative_matrix";
+    if (!dev.fp16) return "the device lacks shaderFloat16";
+    if (!dev.storage16) return "the device lacks storageBuffer16BitAccess";
+    if (dev.subgroup_size != NB_NEURAL_COOP_SUBGROUP)
+        return strfmt("the cooperative-matrix kernel needs subgroups of %u (device: %u)", NB_NEURAL_COOP_SUBGROUP,
+                      dev.subgroup_size);
+    if (dev.max_shared_memory < 24u * 1024u) return "the device has less than 24 KiB of shared memory";
+    if (!has_shape(dev, VK_COMPONENT_TYPE_FLOAT32_NV) && !has_shape(dev, VK_COMPONENT_TYPE_FLOAT16_NV))
+        return "the device has no 16x16x16 fp16 cooperative-matrix shape";
+    return "";
+}
+
+NeuralKernelChoice choose_neural_kernel(const vk::DeviceFeatures& dev, NeuralPath requested) {
+    NeuralKernelChoice c;
+    const std::string why = coopmat_unavailable_reason(dev);
+    if (requested == NeuralPath::scalar || (requested == NeuralPath::automatic && !why.empty())) {
+        c.path = NeuralPath::scalar;
+        return c;
+    }
+    if (!why.empty()) throw Error("--neural-path coopmat: " + why);
+    c.path = NeuralPath::coopmat;
+    c.fp32_accumulate = has_shape(dev, VK_COMPONENT_TYPE_FLOAT32_NV);
+    return c;
+}
+
+std::vector<uint32_t> pack_halves(const std::vector<uint16_t>& halves) {
+    std::vector<uint32_t> words((halves.size() + 1) / 2, 0u);
+    for (size_t i = 0; i < halves.size(); ++i) words[i / 2] |= uint32_t(halves[i]) << (16 * (i & 1));
+    return words;
+}
+
+GpuEncodingBox encoding_box_of(const NeuralModel& model) {
+    return nb_make_encoding_box(model.encoding_box.lo, model.encoding_box.hi);
+}
+
+void pack_lod_nodes(const NeuralModel& model, std::vector<GpuBvhNode>& nodes, std::vector<uint32_t>& roots) {
+    nodes.clear();
+    roots.clear();
+    const NbvhTree tree = model.tree();
+    for (uint32_t lod = 0; lod < std::max(1u, model.lod_count); ++lod) {
+        const uint32_t base = uint32_t(nodes.size());
+        roots.push_back(base);
+        for (GpuBvhNode n : tree.to_gpu_layout(lod)) {
+            if (n.left != NB_CHILD_NONE && !nb_is_leaf(n.left)) n.left += base;
+            if (n.right != NB_CHILD_NONE && !nb_is_leaf(n.right)) n.right += base;
+            nodes.push_back(n);
+        }
+    }
+}
+
+NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model) {
+    const NeuralConfig& c = model.cfg;
+    if (c.grid_levels != NB_GRID_MAX_LEVELS || c.grid_features != NB_GRID_FEATURES ||
+        c.segment_points != NB_SEGMENT_POINTS || c.mlp_width != NB_MLP_WIDTH ||
+        c.mlp_hidden_layers != NB_MLP_HIDDEN_LAYERS || c.mlp_outputs != NB_MLP_OUTPUTS)
+        throw Error("the model's network sizes differ from the renderer's (8 levels x 4 features, 3 points, "
+                    "64 wide, 4 hidden layers, 8 outputs)");
+    if (model.levels.size() != NB_GRID_MAX_LEVELS || model.mlp.size() != NB_MLP_WEIGHT_COUNT || model.grid.empty() ||
+        model.nodes.empty())
+        throw Error("the model has no network or no N-BVH");
+    levels_ = vk::make_buffer(ctx, model.levels, "neural levels");
+    grid_ = vk::make_buffer(ctx, pack_halves(model.grid), "neural grid");
+    mlp_ = vk::make_buffer(ctx, pack_halves(model.mlp), "neural mlp");
+    std::vector<GpuBvhNode> nodes;
+    pack_lod_nodes(model, nodes, roots_);
+    nodes_ = vk::make_buffer(ctx, nodes, "nbvh nodes");
+    std::vector<glm::vec3> bounds;
+    bounds.reserve(model.nodes.size() * 2);
+    for (const NbvhNode& n : model.nodes) {
+        bounds.push_back(n.bounds.lo);
+        bounds.push_back(n.bounds.hi);
+    }
+    leaf_bounds_ = vk::make_buffer(ctx, bounds, "nbvh node bounds");
+    box_ = encoding_box_of(model);
+    bytes_ = levels_.size() + grid_.size() + mlp_.size() + nodes_.size() + leaf_bounds_.size();
+}
+
+uint32_t NeuralModelGpu::lod_root(uint32_t lod) const {
+    NBVH_CHECK(!roots_.empty());
+    return roots_[std::min<size_t>(lod, roots_.size() - 1)];
+}
+
+namespace {
+const char* eval_shader(const NeuralKernelChoice& c) {
+    if (c.path == NeuralPath::scalar) return "passes/neural_eval_scalar.comp";
+    return c.fp32_accumulate ? "passes/neural_eval_coop32.comp" : "passes/neural_eval_coop16.comp";
+}
+} // namespace
+
+NeuralEvaluator::NeuralEvaluator(const vk::Context& ctx, const NeuralModelGpu& model, NeuralKernelChoice choice)
+    : ctx_(ctx), model_(model), choice_(choice) {
+    vk::PipelineDesc desc;
+    desc.shader = eval_shader(choice_);
+    for (uint32_t b = 0; b <= NB_NEVAL_BIND_HITS; ++b) desc.bindings.push_back({b, vk::BindingType::storage_buffer, 1});
+    desc.push_constant_bytes = sizeof(GpuNeuralEvalPush);
+    pipeline_ = vk::ComputePipeline(ctx_, desc);
+}
+
+void NeuralEvaluator::ensure_capacity(size_t count) {
+    if (count <= capacity_) return;
+    capacity_ = std::max<size_t>(count, 64);
+    queries_ = vk::Buffer(ctx_, capacity_ * sizeof(GpuNeuralQuery), vk::MemoryKind::device, 0, "neural queries");
+    hits_ = vk::Buffer(ctx_, capacity_ * sizeof(GpuNeuralHit), vk::MemoryKind::device, 0, "neural hits");
+}
+
+void NeuralEvaluator::upload_queries(const std::vector<GpuNeuralQuery>& queries) {
+    ensure_capacity(queries.size());
+    if (!queries.empty()) queries_.upload(queries.data(), queries.size() * sizeof(GpuNeuralQuery));
+}
+
+std::vector<GpuNeuralHit> NeuralEvaluator::evaluate(const std::vector<GpuNeuralQuery>& queries, float threshold) {
+    if (queries.empty()) return {};
+    upload_queries(queries);
+    time_dispatch(uint32_t(queries.size()), 1, threshold);
+    return hits_.download<GpuNeuralHit>(queries.size());
+}
+
+double NeuralEvaluator::time_dispatch(uint32_t count, int repetitions, float threshold) {
+    NBVH_CHECK(count <= capacity_);
+    vk::DescriptorSet set(ctx_, pipeline_);
+    set.bind(NB_NEVAL_BIND_LEVELS, model_.levels())
+        .bind(NB_NEVAL_BIND_GRID, model_.grid())
+        .bind(NB_NEVAL_BIND_MLP, model_.mlp())
+        .bind(NB_NEVAL_BIND_QUERIES, queries_)
+        .bind(NB_NEVAL_BIND_HITS, hits_);
+    GpuNeuralEvalPush push{};
+    push.box = model_.box();
+    push.count = count;
+    push.threshold = threshold;
+    vk::CommandBuffer cmd(ctx_, "neural eval");
+    vk::GpuTimer timer(ctx_, 2 * std::max(1, repetitions) + 2);
+    cmd.begin();
+    if (timer.available()) timer.reset(cmd.handle());
+    for (int r = 0; r < std::max(1, repetitions); ++r) {
+        cmd.begin_pass("neural eval", timer.available() ? &timer : nullptr);
+        cmd.bind(pipeline_, set).push(push).dispatch_items(count, NB_NEURAL_GROUP);
+        cmd.end_pass();
+        cmd.barrier(vk::Barrier::compute_to_compute);
+    }
+    cmd.barrier(vk::Barrier::compute_to_transfer);
+    cmd.submit_and_wait();
+    double ms = 0.0;
+    if (timer.available())
+        for (const auto& [name, t] : timer.results()) ms += t;
+    return ms / std::max(1, repetitions);
+}
+
+} // namespace nbvh::render

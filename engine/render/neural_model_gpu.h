@@ -1,0 +1,93 @@
+// A NeuralModel (engine/neural/model_file.h) on the GPU, and the choice of the neural MLP path
+// (issue 4): fp16 weights and hash grid packed two halves per uint (shaders/shared/neural_gpu.h), the
+// level table, the encoding box, and the N-BVH cut of every LoD in the two-child node layout
+// (NbvhTree::to_gpu_layout, concatenated; leaf refs carry N-BVH node indices).
+//
+// NeuralEvaluator runs the flat-list query kernels (passes/neural_eval_*.comp) over object-space
+// queries: the shader side of the CPU cross-check tests and of the queries/s benchmark.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "engine/neural/model_file.h"
+#include "engine/vk/buffer.h"
+#include "engine/vk/context.h"
+#include "engine/vk/pipeline.h"
+#include "shaders/shared/neural_gpu.h"
+
+namespace nbvh::render {
+
+// --neural-path: automatic picks the cooperative-matrix path when the device can run it.
+enum class NeuralPath { automatic, scalar, coopmat };
+NeuralPath parse_neural_path(std::string_view text); // throws nbvh::Error
+const char* neural_path_name(NeuralPath path);
+
+// The kernel variant a device runs for a requested path: "scalar", "coop32" (fp32 accumulators) or
+// "coop16". Throws nbvh::Error when coopmat is forced on a device that cannot run it (the message says
+// which requirement is missing).
+struct NeuralKernelChoice {
+    NeuralPath path = NeuralPath::scalar; // resolved: scalar or coopmat
+    bool fp32_accumulate = true;          // coopmat only
+    std::string describe() const;         // "scalar fp16", "cooperative matrix 16x16x16 fp16->fp32"
+};
+NeuralKernelChoice choose_neural_kernel(const vk::DeviceFeatures& dev, NeuralPath requested);
+// Why the cooperative-matrix path is unavailable ("" when it is available).
+std::string coopmat_unavailable_reason(const vk::DeviceFeatures& dev);
+
+// Host-side packing (pure CPU, unit-testable).
+std::vector<uint32_t> pack_halves(const std::vector<uint16_t>& halves); // pairs -> words (low = even)
+GpuEncodingBox encoding_box_of(const NeuralModel& model);
+// Nodes of every LoD concatenated; roots[l] = first node of LoD l. Interior refs are offset so each
+// LoD's nodes index the concatenated array; leaf refs keep N-BVH node indices.
+void pack_lod_nodes(const NeuralModel& model, std::vector<GpuBvhNode>& nodes, std::vector<uint32_t>& roots);
+
+class NeuralModelGpu {
+public:
+    NeuralModelGpu() = default;
+    // Throws nbvh::Error when the model's network sizes differ from the compiled ones.
+    NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model);
+
+    const vk::Buffer& levels() const { return levels_; }
+    const vk::Buffer& grid() const { return grid_; }
+    const vk::Buffer& mlp() const { return mlp_; }
+    const vk::Buffer& nodes() const { return nodes_; }      // GpuBvhNode, all LoDs
+    const vk::Buffer& leaf_bounds() const { return leaf_bounds_; } // vec3 lo, vec3 hi per N-BVH node
+    const GpuEncodingBox& box() const { return box_; }
+    uint32_t lod_count() const { return uint32_t(roots_.size()); }
+    uint32_t lod_root(uint32_t lod) const; // clamps lod to the coarsest
+    uint64_t bytes() const { return bytes_; }
+
+private:
+    vk::Buffer levels_, grid_, mlp_, nodes_, leaf_bounds_;
+    GpuEncodingBox box_{};
+    std::vector<uint32_t> roots_;
+    uint64_t bytes_ = 0;
+};
+
+// Runs the flat-list query kernels.
+class NeuralEvaluator {
+public:
+    NeuralEvaluator(const vk::Context& ctx, const NeuralModelGpu& model, NeuralKernelChoice choice);
+    const NeuralKernelChoice& choice() const { return choice_; }
+
+    // Decoded hits of `queries` (object space, this model's encoding box).
+    std::vector<GpuNeuralHit> evaluate(const std::vector<GpuNeuralQuery>& queries,
+                                       float threshold = NB_VISIBILITY_THRESHOLD);
+    // GPU milliseconds of one dispatch over `count` queries already uploaded by evaluate() or
+    // upload_queries() (timestamps; 0 without). For the benchmark.
+    void upload_queries(const std::vector<GpuNeuralQuery>& queries);
+    double time_dispatch(uint32_t count, int repetitions, float threshold = NB_VISIBILITY_THRESHOLD);
+
+private:
+    void ensure_capacity(size_t count);
+    const vk::Context& ctx_;
+    const NeuralModelGpu& model_;
+    NeuralKernelChoice choice_;
+    vk::ComputePipeline pipeline_;
+    vk::Buffer queries_, hits_;
+    size_t capacity_ = 0;
+};
+
+} // namespace nbvh::render

@@ -1,0 +1,17 @@
+// Bindings and push constants shared by the flat-list neural query kernels (passes/neural_eval_*.comp):
+// queries in, decoded hits out (shared/neural_gpu.h). Tests cross-check them against the CPU
+// reference; the benchmark times them.
+#ifndef NB_NEURAL_EVAL_COMMON_GLSL
+#define NB_NEURAL_EVAL_COMMON_GLSL
+#extension GL_EXT_scalar_block_layout : require
+#include "shared/compat.h"
+#include "shared/hashgrid.h"
+#include "shared/neural_gpu.h"
+
+layout(push_constant, scalar) uniform EvalPushBlock { GpuNeuralEvalPush pc; };
+layout(set = 0, binding = NB_NEVAL_BIND_LEVELS, scalar) readonly buffer LevelBuffer { GpuHashLevel neural_levels[]; };
+layout(set = 0, binding = NB_NEVAL_BIND_GRID, scalar) readonly buffer GridBuffer { uvec2 neural_grid[]; };
+layout(set = 0, binding = NB_NEVAL_BIND_QUERIES, scalar) readonly buffer QueryBuffer { GpuNeuralQuery queries[]; };
+layout(set = 0, binding = NB_NEVAL_BIND_HITS, scalar) writeonly buffer HitBuffer { GpuNeuralHit hits[]; };
+
+#endif

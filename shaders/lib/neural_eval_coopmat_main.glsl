@@ -1,0 +1,30 @@
+// Body of passes/neural_eval_coop{16,32}.comp (the includer defines NB_COOP_ACC_BITS): 64 queries per
+// workgroup through the fused cooperative-matrix MLP.
+#include "lib/neural_eval_common.glsl"
+#extension GL_EXT_shader_16bit_storage : require
+layout(set = 0, binding = NB_NEVAL_BIND_MLP, scalar) readonly buffer MlpBuffer { float16_t neural_mlp_h[]; };
+#include "lib/neural_grid.glsl"
+#include "lib/neural_mlp_coopmat.glsl"
+
+layout(local_size_x = NB_NEURAL_GROUP) in;
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    uint local = gl_LocalInvocationID.x;
+    bool valid = i < pc.count;
+    GpuNeuralQuery q;
+    q.origin = vec3(0.0f);
+    q.dir = vec3(0.0f, 0.0f, 1.0f);
+    q.t_entry = 0.0f;
+    q.t_exit = 0.0f;
+    if (valid) q = queries[i];
+    vec3 p0, p1, p2;
+    nb_segment_points(pc.box, q.origin, q.dir, q.t_entry, q.t_exit, p0, p1, p2);
+    nb_coop_stage_features(local, valid, p0, p1, p2);
+    barrier();
+    nb_mlp_forward_coopmat(); // whole workgroup, uniform control flow
+    if (!valid) return;
+    float y[NB_MLP_OUTPUTS];
+    for (uint r = 0u; r < NB_MLP_OUTPUTS; ++r) y[r] = nb_sigmoid(nb_sh_y[local * NB_MLP_OUTPUTS_PADDED + r]);
+    hits[i] = nb_neural_decode(pc.box, y, q.t_entry, q.t_exit, pc.threshold);
+}
