@@ -1,0 +1,136 @@
+// Benchmark of the neural query kernels (issue 4, not a test): neural queries per second of the scalar
+// and the cooperative-matrix path on the same random queries, and how far the two paths agree.
+//   nbvh_bench_neural [--model M.nbvh] [--queries N] [--reps R] [--device auto|gpu|cpu] [--json out.json]
+// Without --model a random network with varied outputs (tests/neuralvk/neural_test_model.h, hash 2^18,
+// the paper's size) is used: the kernels' cost does not depend on the weights' values.
+// Queries: random rays through random leaf-sized boxes of the asset, a quarter starting inside.
+#include "engine/core/error.h"
+#include "engine/render/neural_model_gpu.h"
+#include "engine/vk/context.h"
+#include "tests/neuralvk/neural_test_model.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <string>
+
+using namespace nbvh;
+using namespace nbvh::render;
+
+namespace {
+
+std::vector<GpuNeuralQuery> make_queries(size_t n, glm::vec3 lo, glm::vec3 hi, uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::vector<GpuNeuralQuery> out;
+    out.reserve(n);
+    const glm::vec3 ext = hi - lo;
+    while (out.size() < n) {
+        // Leaf-sized boxes (1/16 of the asset per axis), as a cut of ~1000 nodes gives.
+        glm::vec3 c = lo + ext * glm::vec3(u(rng), u(rng), u(rng));
+        glm::vec3 llo = c - ext * (1.0f / 32.0f), lhi = c + ext * (1.0f / 32.0f);
+        glm::vec3 dir = glm::normalize(glm::vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f) + 1e-6f);
+        glm::vec3 org = (out.size() % 4 == 0) ? c : c - dir * glm::length(ext) * u(rng);
+        GpuNeuralQuery q;
+        q.origin = org;
+        q.dir = dir;
+        if (!nb_neural_leaf_interval(org, nb_safe_inv_dir(dir), llo, lhi, q.t_entry, q.t_exit)) continue;
+        out.push_back(q);
+    }
+    return out;
+}
+
+} // namespace
+
+int main(int argc, char** argv) try {
+    std::string model_path, json_path, device = "auto";
+    size_t n = size_t(1) << 22;
+    int reps = 10;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto next = [&]() -> std::string {
+            if (i + 1 >= argc) throw Error(a + " needs a value");
+            return argv[++i];
+        };
+        if (a == "--model") model_path = next();
+        else if (a == "--queries") n = std::stoull(next());
+        else if (a == "--reps") reps = std::stoi(next());
+        else if (a == "--device") device = next();
+        else if (a == "--json") json_path = next();
+        else throw Error("unknown option " + a);
+    }
+    vk::ContextOptions o;
+    o.device = vk::parse_device_choice(device);
+    vk::Context ctx(o);
+    const vk::DeviceFeatures& dev = ctx.features();
+    std::printf("device: %s (%s %s)\n", dev.device_name.c_str(), dev.driver_name.c_str(), dev.driver_info.c_str());
+    for (const auto& s : dev.coop_matrix_shapes) std::printf("  coopmat shape %s\n", s.describe().c_str());
+
+    test::TestModel tm = test::make_test_model(42, glm::vec3(-1.0f), glm::vec3(1.0f), 18);
+    NeuralModel model = tm.model;
+    if (!model_path.empty()) model = load_model(model_path);
+    NeuralModelGpu gpu(ctx, model);
+    const std::vector<GpuNeuralQuery> qs =
+        make_queries(n, model.encoding_box.lo, model.encoding_box.hi, 1234);
+
+    struct Row { std::string path; double ms = 0; double qps = 0; std::vector<GpuNeuralHit> hits; };
+    std::vector<Row> rows;
+    std::vector<NeuralPath> paths = {NeuralPath::scalar};
+    const std::string why = coopmat_unavailable_reason(dev);
+    if (why.empty()) paths.push_back(NeuralPath::coopmat);
+    else std::printf("cooperative-matrix path unavailable: %s\n", why.c_str());
+    for (NeuralPath p : paths) {
+        NeuralEvaluator ev(ctx, gpu, choose_neural_kernel(dev, p));
+        Row r;
+        r.path = ev.choice().describe();
+        r.hits = ev.evaluate(qs); // also warms up
+        r.ms = ev.time_dispatch(uint32_t(qs.size()), reps);
+        r.qps = r.ms > 0 ? double(qs.size()) / (r.ms * 1e-3) : 0.0;
+        std::printf("%-70s %9.3f ms / %zu queries = %.3f G queries/s\n", r.path.c_str(), r.ms, qs.size(), r.qps * 1e-9);
+        rows.push_back(std::move(r));
+    }
+    std::string agree = "{}";
+    if (rows.size() == 2) {
+        double max_dy = 0, sum_dy = 0;
+        size_t vis_diff = 0, vis_diff_outside_margin = 0, nonfinite = 0;
+        for (size_t i = 0; i < qs.size(); ++i) {
+            const GpuNeuralHit& a = rows[0].hits[i];
+            const GpuNeuralHit& b = rows[1].hits[i];
+            if (!std::isfinite(b.visibility) || !std::isfinite(b.t) || !std::isfinite(b.normal.x)) ++nonfinite;
+            double d = std::max({std::abs(a.visibility - b.visibility), std::abs(a.depth - b.depth),
+                                 std::abs(a.albedo.x - b.albedo.x), std::abs(a.albedo.y - b.albedo.y),
+                                 std::abs(a.albedo.z - b.albedo.z)});
+            max_dy = std::max(max_dy, d);
+            sum_dy += d;
+            if ((a.flags & NB_NEURAL_VISIBLE) != (b.flags & NB_NEURAL_VISIBLE)) {
+                ++vis_diff;
+                if (std::abs(a.visibility - NB_VISIBILITY_THRESHOLD) > 2e-3f) ++vis_diff_outside_margin;
+            }
+        }
+        std::printf("scalar vs coopmat: max |dy| %.3g, mean |dy| %.3g, visibility differs on %zu of %zu (%zu with "
+                    "|y0 - 0.5| > 2e-3), non-finite coopmat outputs %zu\n",
+                    max_dy, sum_dy / double(qs.size()), vis_diff, qs.size(), vis_diff_outside_margin, nonfinite);
+        char buf[512];
+        std::snprintf(buf, sizeof buf,
+                      "{\"max_abs_dy\": %.6g, \"mean_abs_dy\": %.6g, \"visibility_differs\": %zu, "
+                      "\"visibility_differs_outside_2e-3\": %zu, \"nonfinite\": %zu}",
+                      max_dy, sum_dy / double(qs.size()), vis_diff, vis_diff_outside_margin, nonfinite);
+        agree = buf;
+    }
+    if (!json_path.empty()) {
+        std::ofstream f(json_path);
+        f << "{\n  \"device\": \"" << dev.device_name << "\",\n  \"driver\": \"" << dev.driver_name << " "
+          << dev.driver_info << "\",\n  \"queries\": " << qs.size() << ",\n  \"reps\": " << reps
+          << ",\n  \"model\": \"" << (model_path.empty() ? "random (hash 2^18)" : model_path) << "\",\n  \"paths\": [";
+        for (size_t i = 0; i < rows.size(); ++i)
+            f << (i ? ", " : "") << "{\"path\": \"" << rows[i].path << "\", \"ms\": " << rows[i].ms
+              << ", \"queries_per_s\": " << rows[i].qps << "}";
+        f << "],\n  \"scalar_vs_coopmat\": " << agree << "\n}\n";
+    }
+    return 0;
+} catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+}
