@@ -3,6 +3,7 @@
 #ifndef NB_CUDA_VEC_H
 #define NB_CUDA_VEC_H
 #include <cstdint>
+#include <cstring>
 
 #define NB_V __host__ __device__ inline
 
@@ -43,13 +44,10 @@ NB_VEC3_BINOP(+) NB_VEC3_BINOP(-) NB_VEC3_BINOP(*) NB_VEC3_BINOP(/)
 NB_V vec3 operator-(vec3 a) { return vec3(-a.x, -a.y, -a.z); }
 NB_V uvec3 operator+(uvec3 a, uvec3 b) { return uvec3(a.x + b.x, a.y + b.y, a.z + b.z); }
 
-NB_V float min(float a, float b) { return fminf(a, b); }
-NB_V float max(float a, float b) { return fmaxf(a, b); }
+// Scalar min/max(float) and min/max(unsigned) come from CUDA's math_functions.hpp (host + device).
 NB_V float clamp(float x, float a, float b) { return fminf(fmaxf(x, a), b); }
 NB_V float mix(float a, float b, float t) { return a + (b - a) * t; }
 NB_V float fract(float x) { return x - floorf(x); }
-NB_V uint32_t min(uint32_t a, uint32_t b) { return a < b ? a : b; }
-NB_V uint32_t max(uint32_t a, uint32_t b) { return a > b ? a : b; }
 NB_V vec3 min(vec3 a, vec3 b) { return vec3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)); }
 NB_V vec3 max(vec3 a, vec3 b) { return vec3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)); }
 NB_V vec3 abs(vec3 a) { return vec3(fabsf(a.x), fabsf(a.y), fabsf(a.z)); }
@@ -62,8 +60,9 @@ NB_V vec3 cross(vec3 a, vec3 b) { return vec3(a.y * b.z - a.z * b.y, a.z * b.x -
 NB_V float length(vec3 a) { return sqrtf(dot(a, a)); }
 NB_V vec3 normalize(vec3 a) { return a * rsqrtf(dot(a, a)); }
 NB_V float inversesqrt(float x) { return rsqrtf(x); }
-NB_V uint32_t floatBitsToUint(float x) { return __float_as_uint(x); }
-NB_V float uintBitsToFloat(uint32_t u) { return __uint_as_float(u); }
+// memcpy instead of __float_as_uint (device-only): valid in host and device code, compiles to a move.
+NB_V uint32_t floatBitsToUint(float x) { uint32_t u; memcpy(&u, &x, 4); return u; }
+NB_V float uintBitsToFloat(uint32_t u) { float x; memcpy(&x, &u, 4); return x; }
 
 #undef NB_V
 #endif

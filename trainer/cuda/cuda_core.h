@@ -1,0 +1,96 @@
+// Plain C++ interface between the host glue (cuda_backend.cpp, compiled by g++ with glm) and the
+// CUDA side (cuda_core.cu, compiled by nvcc without glm). Only POD arrays and the shared GPU structs
+// of shaders/shared/ cross it.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "shaders/shared/bvh_node.h"
+#include "shaders/shared/hashgrid.h"
+#include "shaders/shared/neural_query.h"
+
+namespace nbvh::cuda {
+
+// Everything about the asset the GPU needs, in flat host arrays (uploaded once).
+struct CoreAsset {
+    // Base BVH of the N-BVH cut (CPU node order): regularised boxes (lo xyz, hi xyz) and children
+    // (left, right; 0xFFFFFFFF for none).
+    std::vector<float> node_boxes;      // 6 per node
+    std::vector<uint32_t> node_children; // 2 per node
+    // Triangle BVH for the ground truth: GPU layout (leaf refs index triangles in leaf order).
+    std::vector<GpuBvhNode> mesh_nodes;
+    std::vector<float> tri_vertices;    // 9 per triangle (leaf order)
+    std::vector<float> tri_normals;     // 9 per triangle: unit vertex normals (leaf order)
+    std::vector<float> tri_albedo;      // 9 per triangle: per-vertex albedo (factor x texture at the vertex uv)
+    std::vector<float> tri_geo_normal;  // 3 per triangle: unit geometric normal (fallback)
+    GpuEncodingBox encoding;
+    float sampling_lo[3], sampling_ext[3];
+    float min_exit = 0.0f;
+};
+
+struct CoreConfig {
+    std::vector<GpuHashLevel> levels;   // 8 levels
+    std::vector<float> grid;            // initial fp32 grid
+    std::vector<float> mlp;             // initial fp32 MLP (19456)
+    float beta1 = 0.9f, beta2 = 0.999f, epsilon = 1e-8f, l2_reg = 1e-8f, non_matrix_l2_reg = 0.0f;
+    bool skip_zero_grad_non_matrix = true;
+    // Loss weights (paper 2, 2, 1, 1), linearised normals, visibility masking (engine/neural/losses.h).
+    float w_vis = 2.0f, w_depth = 2.0f, w_normal = 1.0f, w_albedo = 1.0f;
+    bool normal_linear = true, masking = true;
+    float bce_clamp = 0, rel_l2_eps = 0, normal_scale = 0, normal_offset = 0; // losses.h NB_* constants
+    bool deterministic = false;
+    float loss_scale = 128.0f;          // initial per-sample loss scale (power of two)
+};
+
+struct CoreCut {
+    std::vector<int32_t> leaf_of_base_node;
+    uint32_t leaves = 0;
+};
+
+struct CoreStepIn {
+    uint32_t step = 0, batch = 0;
+    uint64_t seed = 0;
+    float learning_rate = 0.0f;         // Adam lr for this optimiser step (schedule applied by the caller)
+    const std::vector<float>* keep_probability = nullptr; // cuts[0]
+};
+
+struct CoreStepOut {
+    double vis = 0, depth = 0, normal = 0, albedo = 0, total = 0; // sums over trained samples
+    uint32_t samples = 0, hits = 0;
+    uint64_t draws = 0;
+    bool skipped = false;
+    std::string reason;
+    std::vector<double> leaf_loss;
+    std::vector<uint32_t> leaf_samples, leaf_draws;
+};
+
+// One drawn sample as the GPU saw it (debug / tests).
+struct CoreSample {
+    float origin[3], dir[3], length;
+    int32_t leaf;
+    uint32_t cut;
+    float target[8];
+};
+
+struct CoreTimings { float sample_ms = 0, truth_ms = 0, encode_ms = 0, mlp_ms = 0, grid_bwd_ms = 0, adam_ms = 0; };
+
+class Core {
+public:
+    virtual ~Core() = default;
+    virtual void set_cuts(const std::vector<CoreCut>& cuts) = 0;
+    virtual void step(const CoreStepIn& in, CoreStepOut& out) = 0;
+    virtual void read_weights(std::vector<float>& mlp, std::vector<float>& grid) const = 0;
+    // Debug: samples and normalised gradients of the last step (call after step()).
+    virtual void read_last(std::vector<CoreSample>& samples, std::vector<float>& mlp_grad,
+                           std::vector<float>& grid_grad) const = 0;
+    virtual float loss_scale() const = 0;
+    virtual void set_timing(bool on) = 0;     // per-phase CUDA-event timings (adds syncs)
+    virtual CoreTimings timings() const = 0;  // of the last step
+};
+
+bool device_available(std::string* name = nullptr);
+std::unique_ptr<Core> make_core(const CoreAsset& asset, const CoreConfig& config);
+
+} // namespace nbvh::cuda

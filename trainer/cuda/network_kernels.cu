@@ -1,0 +1,357 @@
+// The network part of a training step (paper §4): hash-grid encoding of the 3 segment points
+// (fp16 features, shared/hashgrid.h), the fully fused MLP forward + loss + backward on tensor cores
+// (WMMA 16x16x16, fp16 inputs, fp32 accumulation, activations kept in shared memory per 128-sample
+// tile), and the grid backward (scatter to the 8 corners of every level).
+//
+// MLP kernel layout (one block = 8 warps = 128 samples per tile, persistent over tiles):
+//   shared: W (fp16, 19456), X0 (128 x 96), H1..H4 (128 x 64; H_{m+1} is overwritten by dZ_m once
+//   dW_{m+1} has consumed it), dZ4 (128 x 16), per-warp fp32 staging (16 x 64).
+//   Forward and the data path of the backward are warp-local (16 samples each); weight gradients
+//   dW_m = dZ_m^T X_m use K = 128 (the whole tile) and accumulate into the block's own fp32 slice in
+//   global memory (L2-resident); slices are summed in a fixed order afterwards, so MLP gradients are
+//   deterministic without atomics.
+#include <mma.h>
+
+#include "trainer/cuda/device_common.cuh"
+
+namespace nbvh::cuda {
+namespace {
+using namespace nvcuda;
+
+constexpr int kWarps = 8;
+constexpr int kTile = 16 * kWarps; // samples per block tile
+constexpr int kLdIn = NB_MLP_INPUTS + 8;  // 104 halves (padding against bank conflicts)
+constexpr int kLdH = NB_MLP_WIDTH + 8;    // 72
+constexpr int kLdO = 16 + 8;              // 24
+constexpr int kLdS = NB_MLP_WIDTH + 4;    // 68 floats
+
+constexpr size_t kSmemW = NB_MLP_WEIGHT_COUNT * 2;
+constexpr size_t kSmemX0 = size_t(kTile) * kLdIn * 2;
+constexpr size_t kSmemH = size_t(kTile) * kLdH * 2;
+constexpr size_t kSmemO = size_t(kTile) * kLdO * 2;
+constexpr size_t kSmemS = size_t(kWarps) * 16 * kLdS * 4;
+constexpr size_t kSmemTotal = kSmemW + kSmemX0 + 4 * kSmemH + kSmemO + kSmemS;
+
+// ---------------------------------------------------------------------------------------------
+// Grid forward: one thread per (sample, point, level).
+__global__ void k_encode(DevNetwork net, DevBatch b) {
+    const uint32_t tid = blockIdx.x * blockDim.x + threadIdx.x;
+    const uint32_t per = NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS;
+    if (tid >= b.n * per) return;
+    const uint32_t i = tid / per, r = tid % per, k = r / NB_GRID_MAX_LEVELS, l = r % NB_GRID_MAX_LEVELS;
+    __half2 out[2];
+    if (b.leaf[i] < 0) {
+        out[0] = out[1] = __floats2half2_rn(0.0f, 0.0f);
+    } else {
+        const float* pp = b.points + 9 * size_t(i) + 3 * k;
+        const vec3 p(pp[0], pp[1], pp[2]);
+        const GpuHashLevel lv = net.levels[l];
+        uvec3 cell;
+        vec3 frac;
+        nb_grid_position(lv, p, cell, frac);
+        float acc[4] = {0, 0, 0, 0};
+        for (uint32_t c = 0; c < NB_GRID_CORNERS; ++c) {
+            const float w = nb_grid_corner_weight(frac, c);
+            const uint32_t e = nb_grid_corner_entry(lv, cell, c);
+            const uint2 raw = __ldg(reinterpret_cast<const uint2*>(net.grid_h) + e);
+            const __half2 a = *reinterpret_cast<const __half2*>(&raw.x);
+            const __half2 bb = *reinterpret_cast<const __half2*>(&raw.y);
+            const float2 fa = __half22float2(a), fb = __half22float2(bb);
+            acc[0] += w * fa.x; acc[1] += w * fa.y; acc[2] += w * fb.x; acc[3] += w * fb.y;
+        }
+        out[0] = __floats2half2_rn(acc[0], acc[1]);
+        out[1] = __floats2half2_rn(acc[2], acc[3]);
+    }
+    *reinterpret_cast<uint2*>(b.features + size_t(i) * NB_MLP_INPUTS + nb_feature_slot(k, l, 0)) =
+        *reinterpret_cast<const uint2*>(out);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Grid backward: one thread per (sample, point, level), 8 corners x 4 features.
+__global__ void k_grid_backward(DevNetwork net, DevBatch b, int deterministic, uint32_t* flag) {
+    const uint32_t tid = blockIdx.x * blockDim.x + threadIdx.x;
+    const uint32_t per = NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS;
+    if (tid >= b.n * per) return;
+    const uint32_t i = tid / per, r = tid % per, k = r / NB_GRID_MAX_LEVELS, l = r % NB_GRID_MAX_LEVELS;
+    if (b.leaf[i] < 0) return;
+    const float4 df = *reinterpret_cast<const float4*>(b.dfeatures + size_t(i) * NB_MLP_INPUTS + nb_feature_slot(k, l, 0));
+    if (!isfinite(df.x + df.y + df.z + df.w)) { atomicOr(flag, NB_GUARD_GRADIENT); return; }
+    if (df.x == 0.0f && df.y == 0.0f && df.z == 0.0f && df.w == 0.0f) return;
+    const float* pp = b.points + 9 * size_t(i) + 3 * k;
+    const vec3 p(pp[0], pp[1], pp[2]);
+    const GpuHashLevel lv = net.levels[l];
+    uvec3 cell;
+    vec3 frac;
+    nb_grid_position(lv, p, cell, frac);
+    for (uint32_t c = 0; c < NB_GRID_CORNERS; ++c) {
+        const float w = nb_grid_corner_weight(frac, c);
+        const uint32_t e = nb_grid_corner_entry(lv, cell, c);
+        if (deterministic) {
+            // Integer addition is associative: the sum does not depend on the atomics' order.
+            unsigned long long* dst = net.grid_grad_fx + size_t(e) * 4;
+            atomicAdd(dst + 0, (unsigned long long)llrintf(w * df.x * NB_CUDA_FIXED_SCALE));
+            atomicAdd(dst + 1, (unsigned long long)llrintf(w * df.y * NB_CUDA_FIXED_SCALE));
+            atomicAdd(dst + 2, (unsigned long long)llrintf(w * df.z * NB_CUDA_FIXED_SCALE));
+            atomicAdd(dst + 3, (unsigned long long)llrintf(w * df.w * NB_CUDA_FIXED_SCALE));
+        } else {
+            float* dst = net.grid_grad + size_t(e) * 4;
+#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900
+            atomicAdd(reinterpret_cast<float4*>(dst), make_float4(w * df.x, w * df.y, w * df.z, w * df.w));
+#else
+            atomicAdd(dst + 0, w * df.x);
+            atomicAdd(dst + 1, w * df.y);
+            atomicAdd(dst + 2, w * df.z);
+            atomicAdd(dst + 3, w * df.w);
+#endif
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Fused MLP.
+using FragA = wmma::fragment<wmma::matrix_a, 16, 16, 16, __half, wmma::row_major>;
+using FragAc = wmma::fragment<wmma::matrix_a, 16, 16, 16, __half, wmma::col_major>;
+using FragBc = wmma::fragment<wmma::matrix_b, 16, 16, 16, __half, wmma::col_major>;
+using FragBr = wmma::fragment<wmma::matrix_b, 16, 16, 16, __half, wmma::row_major>;
+using FragC = wmma::fragment<wmma::accumulator, 16, 16, 16, float>;
+
+// Y(16 x 64) = X(16 x K) W_m^T for one warp, into staging (fp32).
+__device__ void layer_forward(const __half* x, int ldx, const __half* w, int k_in, float* stage) {
+    for (int j = 0; j < 4; ++j) {
+        FragC acc;
+        wmma::fill_fragment(acc, 0.0f);
+        for (int kk = 0; kk < k_in / 16; ++kk) {
+            FragA a;
+            FragBc bm;
+            wmma::load_matrix_sync(a, x + kk * 16, ldx);
+            wmma::load_matrix_sync(bm, w + size_t(j) * 16 * k_in + kk * 16, k_in); // W^T as col-major
+            wmma::mma_sync(acc, a, bm, acc);
+        }
+        wmma::store_matrix_sync(stage + j * 16, acc, kLdS, wmma::mem_row_major);
+    }
+}
+
+// dX(16 x n_out*16) = dZ(16 x k_rows) W_m (k_rows x cols) for one warp. W_m row-major (rows x cols).
+__device__ void layer_backward_data(const __half* dz, int lddz, const __half* w, int rows, int cols, int j0, int j1,
+                                    float* out, int ldo) {
+    for (int j = j0; j < j1; ++j) {
+        FragC acc;
+        wmma::fill_fragment(acc, 0.0f);
+        for (int kk = 0; kk < rows / 16; ++kk) {
+            FragA a;
+            FragBr bm;
+            wmma::load_matrix_sync(a, dz + kk * 16, lddz);
+            wmma::load_matrix_sync(bm, w + size_t(kk) * 16 * cols + j * 16, cols);
+            wmma::mma_sync(acc, a, bm, acc);
+        }
+        wmma::store_matrix_sync(out + (j - j0) * 16, acc, ldo, wmma::mem_row_major);
+    }
+}
+
+// dW_m (rows x cols, row-major in `slice`) += dZ^T (rows x 128) X (128 x cols), tiles split over warps.
+__device__ void weight_grad(const __half* dz, int lddz, const __half* x, int ldx, int rows, int cols, float* slice,
+                            int warp) {
+    const int tiles_c = cols / 16, tiles = (rows / 16) * tiles_c;
+    for (int t = warp; t < tiles; t += kWarps) {
+        const int tr = t / tiles_c, tc = t % tiles_c;
+        FragC acc;
+        float* dst = slice + size_t(tr) * 16 * cols + tc * 16;
+        wmma::load_matrix_sync(acc, dst, cols, wmma::mem_row_major);
+        for (int kk = 0; kk < kTile / 16; ++kk) {
+            FragAc a;
+            FragBr bm;
+            wmma::load_matrix_sync(a, dz + size_t(kk) * 16 * lddz + tr * 16, lddz); // dZ^T: col-major view
+            wmma::load_matrix_sync(bm, x + size_t(kk) * 16 * ldx + tc * 16, ldx);
+            wmma::mma_sync(acc, a, bm, acc);
+        }
+        wmma::store_matrix_sync(dst, acc, cols, wmma::mem_row_major);
+    }
+}
+
+__device__ float sgnf(float x) { return x > 0.0f ? 1.0f : (x < 0.0f ? -1.0f : 0.0f); }
+
+__global__ void __launch_bounds__(kWarps * 32, 1)
+k_mlp(DevNetwork net, DevBatch b, LossParams lp, float* slices, uint32_t* flag) {
+    extern __shared__ __align__(128) unsigned char smem[];
+    __half* sW = reinterpret_cast<__half*>(smem);
+    __half* sX0 = reinterpret_cast<__half*>(smem + kSmemW);
+    __half* sH[4];
+    for (int m = 0; m < 4; ++m) sH[m] = reinterpret_cast<__half*>(smem + kSmemW + kSmemX0 + m * kSmemH);
+    __half* sO = reinterpret_cast<__half*>(smem + kSmemW + kSmemX0 + 4 * kSmemH);
+    float* sS = reinterpret_cast<float*>(smem + kSmemW + kSmemX0 + 4 * kSmemH + kSmemO);
+
+    const int warp = threadIdx.x / 32, lane = threadIdx.x % 32;
+    float* stage = sS + warp * 16 * kLdS;
+    float* slice = slices + size_t(blockIdx.x) * NB_MLP_WEIGHT_COUNT;
+
+    for (int i = threadIdx.x; i < int(NB_MLP_WEIGHT_COUNT / 8); i += blockDim.x)
+        reinterpret_cast<uint4*>(sW)[i] = reinterpret_cast<const uint4*>(net.mlp_h)[i];
+    __syncthreads();
+
+    const int tiles = int((b.n + kTile - 1) / kTile);
+    for (int tile = blockIdx.x; tile < tiles; tile += gridDim.x) {
+        const int row0 = warp * 16;                  // this warp's rows in the tile buffers
+        const uint32_t s0 = uint32_t(tile) * kTile + row0; // first sample of this warp
+        // Load X0 (16 x 96 halves) for this warp; samples past the batch are zero.
+        for (int e = lane; e < 16 * (NB_MLP_INPUTS / 8); e += 32) {
+            const int r = e / (NB_MLP_INPUTS / 8), c8 = e % (NB_MLP_INPUTS / 8);
+            uint4 v = make_uint4(0, 0, 0, 0);
+            if (s0 + r < b.n) v = reinterpret_cast<const uint4*>(b.features + size_t(s0 + r) * NB_MLP_INPUTS)[c8];
+            *reinterpret_cast<uint4*>(sX0 + (row0 + r) * kLdIn + c8 * 8) = v;
+        }
+        __syncwarp();
+        // Forward, hidden layers: H_{m+1} = fp16(relu(X_m W_m^T)) (rounding point R3 of mlp.h).
+        for (int m = 0; m < 4; ++m) {
+            const __half* x = m == 0 ? sX0 + row0 * kLdIn : sH[m - 1] + row0 * kLdH;
+            layer_forward(x, m == 0 ? kLdIn : kLdH, sW + nb_mlp_layer_offset(m), nb_mlp_layer_inputs(m), stage);
+            __syncwarp();
+            for (int e = lane; e < 16 * 64; e += 32) {
+                const int r = e / 64, c = e % 64;
+                sH[m][(row0 + r) * kLdH + c] = __float2half_rn(fmaxf(stage[r * kLdS + c], 0.0f));
+            }
+            __syncwarp();
+        }
+        // Output layer (16 rows, 8 used): fp32 pre-activation (R4), sigmoid, loss, dZ4.
+        {
+            FragC acc;
+            wmma::fill_fragment(acc, 0.0f);
+            for (int kk = 0; kk < 4; ++kk) {
+                FragA a;
+                FragBc bm;
+                wmma::load_matrix_sync(a, sH[3] + row0 * kLdH + kk * 16, kLdH);
+                wmma::load_matrix_sync(bm, sW + nb_mlp_layer_offset(4) + kk * 16, NB_MLP_WIDTH);
+                wmma::mma_sync(acc, a, bm, acc);
+            }
+            wmma::store_matrix_sync(stage, acc, kLdS, wmma::mem_row_major);
+            __syncwarp();
+            if (lane < 16) {
+                const uint32_t si = s0 + lane;
+                const bool valid = si < b.n && b.leaf[si] >= 0;
+                float g[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+                float lv[5] = {0, 0, 0, 0, 0};
+                if (valid) {
+                    float y[8], t[8];
+                    bool finite = true;
+                    for (int o = 0; o < 8; ++o) {
+                        y[o] = nb_sigmoid(stage[lane * kLdS + o]);
+                        t[o] = b.target[8 * size_t(si) + o];
+                        finite = finite && isfinite(y[o]);
+                    }
+                    if (!finite) {
+                        atomicOr(flag, NB_GUARD_OUTPUT);
+                    } else {
+                        // engine/neural/losses.cpp composite_loss, same formulas.
+                        const float p = fminf(fmaxf(y[0], lp.bce_clamp), 1.0f - lp.bce_clamp);
+                        const float tv = t[0];
+                        const float l0 = lp.w_vis * -(tv * logf(p) + (1.0f - tv) * logf(1.0f - p));
+                        g[0] = lp.w_vis * -(tv - p) / (p - p * p);
+                        float ld = 0.0f, ln = 0.0f, la = 0.0f;
+                        if (!(lp.masking && tv < 0.5f)) {
+                            const float dd = y[1] - t[1];
+                            ld = lp.w_depth * fabsf(dd);
+                            g[1] = lp.w_depth * sgnf(dd);
+                            const float sc = lp.normal_linear ? lp.normal_scale : 1.0f;
+                            const float of = lp.normal_linear ? lp.normal_offset : 0.0f;
+                            for (int o = 2; o < 5; ++o) {
+                                const float dn = sc * y[o] - of - t[o];
+                                ln += lp.w_normal * fabsf(dn);
+                                g[o] = lp.w_normal * sc * sgnf(dn);
+                            }
+                            for (int o = 5; o < 8; ++o) {
+                                const float da = y[o] - t[o];
+                                const float den = y[o] * y[o] + lp.rel_l2_eps;
+                                la += lp.w_albedo * da * da / den;
+                                g[o] = lp.w_albedo * 2.0f * da / den;
+                            }
+                        }
+                        lv[0] = l0 / lp.w_vis;
+                        lv[1] = ld / lp.w_depth;
+                        lv[2] = ln / (3.0f * lp.w_normal);
+                        lv[3] = la / (3.0f * lp.w_albedo);
+                        lv[4] = l0 + ld + ln + la;
+                        if (!isfinite(lv[4])) atomicOr(flag, NB_GUARD_OUTPUT);
+                        for (int o = 0; o < 8; ++o) g[o] = g[o] * y[o] * (1.0f - y[o]) * lp.loss_scale;
+                    }
+                }
+                for (int o = 0; o < 16; ++o) sO[(row0 + lane) * kLdO + o] = __float2half_rn(o < 8 ? g[o] : 0.0f);
+                if (si < b.n)
+                    for (int q = 0; q < 5; ++q) b.loss[5 * size_t(si) + q] = lv[q];
+            }
+            __syncwarp();
+        }
+        // Backward. dX4 = dZ4 W4 (16 x 64) into staging.
+        layer_backward_data(sO + row0 * kLdO, kLdO, sW + nb_mlp_layer_offset(4), 16, NB_MLP_WIDTH, 0, 4, stage, kLdS);
+        __syncthreads();
+        weight_grad(sO, kLdO, sH[3], kLdH, 16, NB_MLP_WIDTH, slice + nb_mlp_layer_offset(4), warp);
+        for (int m = 3; m >= 0; --m) {
+            __syncthreads(); // dW_{m+1} has read H_{m+1} (= sH[m]); it now becomes dZ_m
+            __half* hz = sH[m] + row0 * kLdH;
+            for (int e = lane; e < 16 * 64; e += 32) {
+                const int r = e / 64, c = e % 64;
+                const bool active = __half2float(hz[r * kLdH + c]) > 0.0f; // ReLU'(0) = 0, as tcnn
+                hz[r * kLdH + c] = __float2half_rn(active ? stage[r * kLdS + c] : 0.0f);
+            }
+            __syncwarp();
+            const __half* w = sW + nb_mlp_layer_offset(m);
+            if (m > 0) {
+                layer_backward_data(hz, kLdH, w, NB_MLP_WIDTH, NB_MLP_WIDTH, 0, 4, stage, kLdS);
+            } else {
+                // dL/dfeatures straight to global memory (fp32, loss-scaled), rows past the batch skipped.
+                float* out = b.dfeatures + size_t(s0) * NB_MLP_INPUTS;
+                if (s0 + 16 <= b.n) {
+                    layer_backward_data(hz, kLdH, w, NB_MLP_WIDTH, NB_MLP_INPUTS, 0, 6, out, NB_MLP_INPUTS);
+                } else {
+                    for (int j = 0; j < 6; ++j) {
+                        layer_backward_data(hz, kLdH, w, NB_MLP_WIDTH, NB_MLP_INPUTS, j, j + 1, stage, kLdS);
+                        __syncwarp();
+                        for (int e = lane; e < 256; e += 32) {
+                            const int r = e / 16, c = e % 16;
+                            if (s0 + r < b.n) out[size_t(r) * NB_MLP_INPUTS + j * 16 + c] = stage[r * kLdS + c];
+                        }
+                        __syncwarp();
+                    }
+                }
+            }
+            __syncthreads(); // all dZ_m rows written
+            const __half* xm = m == 0 ? sX0 : sH[m - 1];
+            weight_grad(sH[m], kLdH, xm, m == 0 ? kLdIn : kLdH, NB_MLP_WIDTH, nb_mlp_layer_inputs(m),
+                        slice + nb_mlp_layer_offset(m), warp);
+        }
+        __syncthreads(); // before the next tile overwrites the buffers
+    }
+}
+
+} // namespace
+
+void launch_encode(const DevNetwork& net, const DevBatch& b, cudaStream_t s) {
+    const uint32_t n = b.n * NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS;
+    k_encode<<<(n + 255) / 256, 256, 0, s>>>(net, b);
+    NBVH_CUDA_CHECK(cudaGetLastError());
+}
+
+void launch_grid_backward(const DevNetwork& net, const DevBatch& b, bool deterministic, uint32_t* flag,
+                          cudaStream_t s) {
+    const uint32_t n = b.n * NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS;
+    k_grid_backward<<<(n + 255) / 256, 256, 0, s>>>(net, b, deterministic ? 1 : 0, flag);
+    NBVH_CUDA_CHECK(cudaGetLastError());
+}
+
+void mlp_prepare() {
+    NBVH_CUDA_CHECK(cudaFuncSetAttribute(k_mlp, cudaFuncAttributeMaxDynamicSharedMemorySize, int(kSmemTotal)));
+}
+
+int mlp_blocks_for(uint32_t n) {
+    int dev = 0, sms = 1;
+    NBVH_CUDA_CHECK(cudaGetDevice(&dev));
+    NBVH_CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, dev));
+    const int tiles = int((n + kTile - 1) / kTile);
+    return tiles < sms ? (tiles > 0 ? tiles : 1) : sms;
+}
+
+void launch_mlp(const DevNetwork& net, const DevBatch& b, const LossParams& lp, float* slices, int blocks,
+                uint32_t* flag, cudaStream_t s) {
+    k_mlp<<<blocks, kWarps * 32, kSmemTotal, s>>>(net, b, lp, slices, flag);
+    NBVH_CUDA_CHECK(cudaGetLastError());
+}
+
+} // namespace nbvh::cuda
