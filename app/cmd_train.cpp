@@ -2,6 +2,7 @@
 // SCENE is a glTF file or "default" (the built-in demo scene, assets/). Which assets are neural follows
 // ARCHITECTURE.md: the nodes of a "*_neural" glTF scene, or --neural GLOB.
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "app/commands.h"
@@ -25,8 +26,9 @@ struct TrainArgs {
     std::string out;
     std::string backend = "auto";
     std::string log_csv;
-    // 0 = the backend's default.
-    uint32_t nodes = 0, hash_log2 = 0, steps = 0, batch = 0, lods = 1, threads = 0;
+    // Unset (not given on the command line) = the backend's default.
+    std::optional<uint32_t> nodes, hash_log2, steps, batch;
+    uint32_t lods = 1, threads = 0;
     uint64_t seed = 1337;
 };
 
@@ -40,10 +42,10 @@ BackendChoice parse_backend(const std::string& s) {
 void run_train(const TrainArgs& a) {
     const BackendChoice backend = resolve_backend(parse_backend(a.backend));
     TrainOptions opt = default_train_options(backend);
-    if (a.nodes) opt.target_nodes = a.nodes;
-    if (a.hash_log2) opt.network.log2_hash_size = a.hash_log2;
-    if (a.steps) opt.steps = a.steps;
-    if (a.batch) opt.batch_size = a.batch;
+    if (a.nodes) opt.target_nodes = *a.nodes;
+    if (a.hash_log2) opt.network.log2_hash_size = *a.hash_log2;
+    if (a.steps) opt.steps = *a.steps;
+    if (a.batch) opt.batch_size = *a.batch;
     opt.lods = a.lods;
     opt.seed = a.seed;
     opt.threads = a.threads;
@@ -77,12 +79,12 @@ void run_train(const TrainArgs& a) {
                                 ? (a.scene == "default" ? std::string("default.nbvh")
                                                         : std::filesystem::path(a.scene).stem().string() + ".nbvh")
                                 : a.out;
+    std::unique_ptr<TrainerBackend> be = make_backend(backend, asset, opt);
     const SplitSchedule schedule = make_split_schedule(opt);
     log_info("training '%s' (%u triangles) on %s: %u steps x %u rays, target %u nodes, hash 2^%u, %u LoD(s); %s",
              asset.name.c_str(), asset.triangle_count(), backend == BackendChoice::cuda ? "cuda" : "cpu", opt.steps,
              opt.batch_size, opt.target_nodes, opt.network.log2_hash_size, opt.lods, describe(schedule).c_str());
 
-    std::unique_ptr<TrainerBackend> be = make_backend(backend, asset, opt);
     ProgressBar bar;
     TrainResult result = train_asset(asset, opt, *be, [&](const TrainProgress& p) { bar.update(p); });
     bar.finish();

@@ -12,6 +12,7 @@
 #include <string>
 #include <thread>
 
+#include "assets/default_scene.h"
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/scene/gltf_loader.h"
@@ -42,9 +43,14 @@ int main(int argc, char** argv) try {
         if (!test::shared_dir()) throw Error("../shared/scenes not found; pass --scene");
         scene_path = (test::scenes_dir() / "stanford_bunny" / "stanford_bunny.glb").string();
     }
-    SceneLoadOptions lo;
-    lo.neural_glob = glob;
-    const Scene scene = load_gltf(scene_path, lo);
+    Scene scene;
+    if (scene_path == "default") {
+        scene = assets::make_default_scene(); // its neural asset is flagged by the generator
+    } else {
+        SceneLoadOptions lo;
+        lo.neural_glob = glob;
+        scene = load_gltf(scene_path, lo);
+    }
     const TrainingAsset asset = make_training_asset(scene, pick_neural_mesh(scene));
     const unsigned threads = opt.threads ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
 
