@@ -60,9 +60,7 @@ double rel_l2(const std::vector<float>& a, const std::vector<double>& b) {
     return std::sqrt(num / std::max(den, 1e-300));
 }
 
-TEST(CudaBackend, SamplesTruthLossAndGradientsMatchCpuReference) {
-    REQUIRE_GPU();
-    NBVH_REQUIRE_SHARED();
+void check_against_cpu(bool deterministic) {
     const Scene scene = load_bunny();
     const TrainingAsset asset = make_training_asset(scene, pick_neural_mesh(scene));
     TrainingCut cut = cut_at_depth(asset, 6);
@@ -70,7 +68,7 @@ TEST(CudaBackend, SamplesTruthLossAndGradientsMatchCpuReference) {
     const NeuralConfig cfg{.log2_hash_size = 14};
     neural::AdamConfig adam;
     CudaBackendOptions opt;
-    opt.deterministic = true;
+    opt.deterministic = deterministic;
     auto gpu = make_cuda_backend_ex(asset, cfg, adam, opt, 7);
     StepParams p;
     p.step = 3;
@@ -146,6 +144,19 @@ TEST(CudaBackend, SamplesTruthLossAndGradientsMatchCpuReference) {
                 st.loss.total, cpu_loss, e_mlp, e_grid, same, p.batch_size);
     EXPECT_LT(e_mlp, 2e-2);
     EXPECT_LT(e_grid, 2e-2);
+}
+
+TEST(CudaBackend, SamplesTruthLossAndGradientsMatchCpuReference) {
+    REQUIRE_GPU();
+    NBVH_REQUIRE_SHARED();
+    check_against_cpu(true);
+}
+
+// Fast mode (fp32 atomics, shared-memory accumulation of the coarse levels): same bounds.
+TEST(CudaBackend, FastModeGradientsMatchCpuReference) {
+    REQUIRE_GPU();
+    NBVH_REQUIRE_SHARED();
+    check_against_cpu(false);
 }
 
 TEST(CudaBackend, DeterministicModeIsBitReproducible) {

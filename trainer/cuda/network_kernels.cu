@@ -67,13 +67,49 @@ __global__ void k_encode(DevNetwork net, DevBatch b) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Grid backward: one thread per (sample, point, level), 8 corners x 4 features.
-__global__ void k_grid_backward(DevNetwork net, DevBatch b, int deterministic, uint32_t* flag) {
+// Grid backward of the coarse levels (fast mode): their few entries receive thousands of adds per step,
+// which serialise in L2 as global atomics. Each block accumulates its share of the samples in shared
+// memory and flushes one global add per touched value.
+constexpr uint32_t kCoarseSmemBytes = 96 * 1024;
+__global__ void k_grid_backward_coarse(DevNetwork net, DevBatch b, uint32_t coarse_levels, uint32_t coarse_values,
+                                       uint32_t* flag) {
+    extern __shared__ float acc_s[];
+    for (uint32_t v = threadIdx.x; v < coarse_values; v += blockDim.x) acc_s[v] = 0.0f;
+    __syncthreads();
+    const uint32_t items = b.n * NB_SEGMENT_POINTS * coarse_levels;
+    for (uint32_t t = blockIdx.x * blockDim.x + threadIdx.x; t < items; t += gridDim.x * blockDim.x) {
+        const uint32_t i = t / (NB_SEGMENT_POINTS * coarse_levels), r = t % (NB_SEGMENT_POINTS * coarse_levels);
+        const uint32_t k = r / coarse_levels, l = r % coarse_levels;
+        if (b.leaf[i] < 0) continue;
+        const float4 df = *reinterpret_cast<const float4*>(b.dfeatures + size_t(i) * NB_MLP_INPUTS + nb_feature_slot(k, l, 0));
+        if (!isfinite(df.x + df.y + df.z + df.w)) { atomicOr(flag, NB_GUARD_GRADIENT); continue; }
+        const float* pp = b.points + 9 * size_t(i) + 3 * k;
+        const GpuHashLevel lv = net.levels[l];
+        uvec3 cell;
+        vec3 frac;
+        nb_grid_position(lv, vec3(pp[0], pp[1], pp[2]), cell, frac);
+        for (uint32_t c = 0; c < NB_GRID_CORNERS; ++c) {
+            const float w = nb_grid_corner_weight(frac, c);
+            float* dst = acc_s + size_t(nb_grid_corner_entry(lv, cell, c)) * 4; // coarse levels start at entry 0
+            atomicAdd(dst + 0, w * df.x);
+            atomicAdd(dst + 1, w * df.y);
+            atomicAdd(dst + 2, w * df.z);
+            atomicAdd(dst + 3, w * df.w);
+        }
+    }
+    __syncthreads();
+    for (uint32_t v = threadIdx.x; v < coarse_values; v += blockDim.x)
+        if (acc_s[v] != 0.0f) atomicAdd(net.grid_grad + v, acc_s[v]);
+}
+
+// Grid backward: one thread per (sample, point, level), 8 corners x 4 features. Levels below
+// `first_level` were done by k_grid_backward_coarse.
+__global__ void k_grid_backward(DevNetwork net, DevBatch b, int deterministic, uint32_t first_level, uint32_t* flag) {
     const uint32_t tid = blockIdx.x * blockDim.x + threadIdx.x;
     const uint32_t per = NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS;
     if (tid >= b.n * per) return;
     const uint32_t i = tid / per, r = tid % per, k = r / NB_GRID_MAX_LEVELS, l = r % NB_GRID_MAX_LEVELS;
-    if (b.leaf[i] < 0) return;
+    if (l < first_level || b.leaf[i] < 0) return;
     const float4 df = *reinterpret_cast<const float4*>(b.dfeatures + size_t(i) * NB_MLP_INPUTS + nb_feature_slot(k, l, 0));
     if (!isfinite(df.x + df.y + df.z + df.w)) { atomicOr(flag, NB_GUARD_GRADIENT); return; }
     if (df.x == 0.0f && df.y == 0.0f && df.z == 0.0f && df.w == 0.0f) return;
@@ -332,7 +368,27 @@ void launch_encode(const DevNetwork& net, const DevBatch& b, cudaStream_t s) {
 void launch_grid_backward(const DevNetwork& net, const DevBatch& b, bool deterministic, uint32_t* flag,
                           cudaStream_t s) {
     const uint32_t n = b.n * NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS;
-    k_grid_backward<<<(n + 255) / 256, 256, 0, s>>>(net, b, deterministic ? 1 : 0, flag);
+    // Coarse levels: the leading levels (offset 0..) whose values fit the shared-memory accumulator.
+    uint32_t coarse = 0, values = 0;
+    while (!deterministic && coarse < NB_GRID_MAX_LEVELS &&
+           (net.levels[coarse].offset + net.levels[coarse].size) * 4u * 4u <= kCoarseSmemBytes) {
+        values = (net.levels[coarse].offset + net.levels[coarse].size) * 4u;
+        coarse++;
+    }
+    if (coarse > 0) {
+        static bool attr = false;
+        if (!attr) {
+            NBVH_CUDA_CHECK(cudaFuncSetAttribute(k_grid_backward_coarse, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                                                 int(kCoarseSmemBytes)));
+            attr = true;
+        }
+        int dev = 0, sms = 1;
+        NBVH_CUDA_CHECK(cudaGetDevice(&dev));
+        NBVH_CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, dev));
+        k_grid_backward_coarse<<<2 * sms, 512, values * 4, s>>>(net, b, coarse, values, flag);
+        NBVH_CUDA_CHECK(cudaGetLastError());
+    }
+    k_grid_backward<<<(n + 255) / 256, 256, 0, s>>>(net, b, deterministic ? 1 : 0, coarse, flag);
     NBVH_CUDA_CHECK(cudaGetLastError());
 }
 
