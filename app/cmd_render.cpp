@@ -1,5 +1,10 @@
 // nbvh render SCENE [--out FILE.png|.exr] [--width --height --spp --max-depth --seed] [--device]
 //                   [--camera ex,ey,ez,tx,ty,tz,fov] [--env FILE.hdr|.exr] [--stats FILE.json] [--explain]
+//                   [--model M.nbvh [--lod L] [--secondary-lod L] [--neural-path auto|scalar|coopmat]]
+//                   [--classical] [--neural GLOB] [--neural-roughness R] [--neural-metallic M]
+//                   [--neural-max-leaves N]
+// With --model the scene's neural instances are rendered from the model (hybrid); --classical renders
+// them from their triangles with the same material constants (the reference FLIP compares against).
 // Loads the scene, builds its BVHs, runs the wavefront path tracer (engine/render/) and writes the image
 // (PNG: ACES-fit tone map + sRGB, engine/core/image.h; EXR: linear radiance).
 #include <chrono>
@@ -16,6 +21,7 @@
 #include "engine/core/error.h"
 #include "engine/core/image.h"
 #include "engine/core/log.h"
+#include "engine/neural/model_file.h"
 #include "engine/render/wavefront.h"
 #include "engine/scene/camera.h"
 #include "engine/scene/environment.h"
@@ -26,6 +32,7 @@ namespace {
 
 struct RenderArgs {
     std::string scene, out = "render.png", device = "auto", camera, env, stats;
+    std::string model, neural_path = "auto", neural_glob;
     render::RenderOptions options;
     bool explain = false;
 };
@@ -62,6 +69,16 @@ void write_stats(const std::string& path, const render::RenderStats& s, const st
     j["rays_per_second"] = s.rays_per_second();
     j["non_finite_samples"] = s.nonfinite_samples;
     j["non_finite_pixels"] = s.nonfinite_pixels;
+    if (!s.neural_path.empty()) {
+        nlohmann::json n;
+        n["path"] = s.neural_path;
+        n["queries"] = s.neural_queries;
+        n["rounds"] = s.neural_rounds;
+        n["queries_per_ray"] = s.neural_queries_per_ray();
+        n["query_gpu_ms"] = s.neural_query_ms;
+        n["queries_per_second"] = s.neural_queries_per_second();
+        j["neural"] = n;
+    }
     std::ofstream f(path);
     if (!f) throw Error(strfmt("cannot write stats file '%s'", path.c_str()));
     f << j.dump(2) << "\n";
@@ -70,7 +87,17 @@ void write_stats(const std::string& path, const render::RenderStats& s, const st
 void run_render(const RenderArgs& a) {
     if (!is_png_path(a.out) && !is_exr_path(a.out))
         throw Error(strfmt("--out '%s': expected a .png or .exr file name", a.out.c_str()));
-    Scene scene = load_scene_arg(a.scene);
+    SceneLoadOptions lo;
+    lo.neural_glob = a.neural_glob;
+    Scene scene = load_scene_arg(a.scene, lo);
+    if (a.scene == "default" && !a.neural_glob.empty()) mark_neural_by_glob(scene, a.neural_glob);
+    render::RenderOptions options = a.options;
+    NeuralModel model;
+    if (!a.model.empty() && !options.neural.classical) {
+        model = load_model(a.model);
+        options.neural.model = &model;
+    }
+    options.neural.path = render::parse_neural_path(a.neural_path);
     const Environment env = choose_environment(scene, a.env);
     const float aspect = float(a.options.width) / float(std::max(1u, a.options.height));
     const Camera camera = !a.camera.empty() ? parse_camera(a.camera) : scene.has_camera ? scene.camera
@@ -86,11 +113,15 @@ void run_render(const RenderArgs& a) {
     vk::ContextOptions copt;
     copt.device = vk::parse_device_choice(a.device);
     vk::Context ctx(copt);
-    render::WavefrontRenderer renderer(ctx, scene, accel, env, camera, a.options);
+    render::WavefrontRenderer renderer(ctx, scene, accel, env, camera, options);
     render::RenderResult result = renderer.render();
     const render::RenderStats& s = result.stats;
     log_info("render: %ux%u, %u spp on %s: %.1f ms GPU, %.3g rays/s, %llu non-finite pixels", s.width, s.height,
              s.spp, s.device.c_str(), s.gpu_ms, s.rays_per_second(), (unsigned long long)s.nonfinite_pixels);
+    if (!s.neural_path.empty())
+        log_info("render: neural %s: %llu queries (%.2f per ray), %.3g queries/s over %.2f ms of query passes",
+                 s.neural_path.c_str(), (unsigned long long)s.neural_queries, s.neural_queries_per_ray(),
+                 s.neural_queries_per_second(), s.neural_query_ms);
     if (is_exr_path(a.out)) {
         save_exr(a.out, convert_channels(result.image, 3));
     } else {
@@ -121,6 +152,18 @@ void add_render_command(CLI::App& app) {
     cmd->add_option("--env", args->env, "environment map (.hdr or .exr, equirectangular)");
     cmd->add_option("--stats", args->stats, "write per-pass GPU times, ray counts and checks as JSON");
     cmd->add_flag("--explain", args->explain, "print the scene's feature set and the passes, then exit");
+    cmd->add_option("--model", args->model, "N-BVH model (.nbvh) for the scene's neural instances (hybrid render)");
+    cmd->add_flag("--classical", args->options.neural.classical,
+                  "reference: neural instances from their triangles, shaded with the neural material constants");
+    cmd->add_option("--neural", args->neural_glob, "nodes whose name matches this glob are neural instances");
+    cmd->add_option("--lod", args->options.neural.lod, "N-BVH level of detail of camera rays (0 = finest)");
+    cmd->add_option("--secondary-lod", args->options.neural.secondary_lod,
+                    "N-BVH level of detail after the first hit (default: --lod)");
+    cmd->add_option("--neural-path", args->neural_path, "MLP implementation: auto, scalar or coopmat");
+    cmd->add_option("--neural-roughness", args->options.neural.roughness, "roughness of neural surfaces [0,1]");
+    cmd->add_option("--neural-metallic", args->options.neural.metallic, "metallic of neural surfaces [0,1]");
+    cmd->add_option("--neural-max-leaves", args->options.neural.max_rounds,
+                    "neural leaves queried per ray at most (then the closest hit so far is kept)");
     cmd->callback([args] { run_render(*args); });
 }
 

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "engine/neural/model_file.h"
@@ -58,6 +59,14 @@ public:
     uint32_t lod_count() const { return uint32_t(roots_.size()); }
     uint32_t lod_root(uint32_t lod) const; // clamps lod to the coarsest
     uint64_t bytes() const { return bytes_; }
+    // Hands the buffers to a renderer that binds them by slot (this object keeps box and roots).
+    void move_into(vk::Buffer& levels, vk::Buffer& grid, vk::Buffer& mlp, vk::Buffer& nodes, vk::Buffer& bounds) {
+        levels = std::move(levels_);
+        grid = std::move(grid_);
+        mlp = std::move(mlp_);
+        nodes = std::move(nodes_);
+        bounds = std::move(leaf_bounds_);
+    }
 
 private:
     vk::Buffer levels_, grid_, mlp_, nodes_, leaf_bounds_;

@@ -13,11 +13,17 @@ namespace nbvh::render {
 
 namespace {
 
-enum Pass : size_t { CAMERA, QUEUE_ARGS, TRAVERSE, SHADE, SHADOW, ACCUMULATE, RESOLVE, PASS_COUNT };
+enum Pass : size_t {
+    CAMERA, QUEUE_ARGS, TRAVERSE, SHADE, SHADOW, ACCUMULATE, RESOLVE,
+    NEURAL_TRAVERSE, NEURAL_ARGS, NEURAL_QUERY, // hybrid renders only (neural_stage.h)
+    PASS_COUNT
+};
+// NEURAL_QUERY's shader depends on the MLP path (NeuralStage::query_shader); this entry names its timer.
 const char* const PASS_SHADERS[PASS_COUNT] = {"passes/camera_rays.comp", "passes/queue_args.comp",
                                               "passes/traverse.comp",    "passes/shade.comp",
                                               "passes/shadow.comp",      "passes/accumulate.comp",
-                                              "passes/resolve.comp"};
+                                              "passes/resolve.comp",     "passes/neural_traverse.comp",
+                                              "passes/neural_args.comp", "passes/neural_query.comp"};
 
 template <class T> vk::Buffer upload(const vk::Context& ctx, const std::vector<T>& items, const char* name) {
     return vk::make_buffer(ctx, items, name);
@@ -48,6 +54,13 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     PackOptions pack;
     pack.textures = features_.textures;
     data_ = pack_scene(scene, accel, environment, pack);
+    // Neural instances: N-BVH + network (hybrid), or triangles with the neural material constants
+    // (classical reference); without either they render as plain triangles.
+    const NeuralRenderOptions& nopt = options_.neural;
+    if (nopt.model || nopt.classical) validate(nopt, scene);
+    if (nopt.classical) apply_classical_materials(scene, data_, nopt.roughness, nopt.metallic);
+    const bool hybrid = nopt.model && !nopt.classical;
+    if (hybrid) features_.neural = mark_neural_instances(scene, data_) > 0;
     if (features_.emission && data_.lights.size() == 1 && data_.light_total_power <= 0.0f) features_.emission = false;
 
     // Per-render parameters.
@@ -99,9 +112,15 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     buffers_[NB_BIND_SAMPLE_RADIANCE] =
         vk::Buffer(ctx_, uint64_t(capacity_) * sizeof(vec3), vk::MemoryKind::device, 0, "sample radiance");
     buffers_[NB_BIND_FILM] = vk::Buffer(ctx_, pixels * sizeof(vec4), vk::MemoryKind::device, 0, "film");
-    // Neural issue: sized by the pending-leaf capacity; a placeholder until neural instances exist.
+    // Pending (ray, leaf) pairs and the neural bindings: sized by the ray capacity in hybrid renders,
+    // placeholders otherwise (every pass shares one set-0 layout).
     buffers_[NB_BIND_PENDING_LEAVES] =
         vk::Buffer(ctx_, sizeof(GpuPendingLeaf), vk::MemoryKind::device, 0, "pending leaves");
+    NeuralStage::install_placeholders(ctx_, buffers_);
+    if (features_.neural) {
+        neural_ = std::make_unique<NeuralStage>(ctx_, *nopt.model, nopt, capacity_);
+        neural_->install(buffers_);
+    }
     buffers_[NB_BIND_OUTPUT] = vk::Buffer(ctx_, pixels * sizeof(vec4), vk::MemoryKind::device, 0, "output");
     for (uint32_t b : {NB_BIND_COUNTERS, NB_BIND_RAYS, NB_BIND_HITS, NB_BIND_SHADOW_RAYS, NB_BIND_SAMPLE_RADIANCE,
                        NB_BIND_FILM, NB_BIND_PENDING_LEAVES, NB_BIND_OUTPUT})
@@ -109,25 +128,25 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
 
     // One pipeline per pass, all with the same set-0 layout and the scene's specialization.
     std::vector<vk::Binding> bindings;
-    for (uint32_t b = 0; b < NB_BINDING_COUNT; ++b) bindings.push_back({b, vk::BindingType::storage_buffer, 1});
+    for (uint32_t b = 0; b < NB_NEURAL_BINDING_END; ++b) bindings.push_back({b, vk::BindingType::storage_buffer, 1});
     const std::vector<vk::SpecConstant> spec = specialization(features_);
     for (size_t i = 0; i < PASS_COUNT; ++i) {
-        if (i == SHADOW && !features_.has_lights()) {
+        if ((i == SHADOW && !features_.has_lights()) || (i >= NEURAL_TRAVERSE && !neural_)) {
             pipelines_.emplace_back();
             sets_.emplace_back();
             continue; // no shadow pass without anything to sample
         }
         vk::PipelineDesc desc;
-        desc.shader = PASS_SHADERS[i];
+        desc.shader = i == NEURAL_QUERY ? neural_->query_shader() : PASS_SHADERS[i];
         desc.bindings = bindings;
         desc.spec = spec;
         desc.push_constant_bytes = sizeof(GpuPassConstants);
         pipelines_.emplace_back(ctx_, desc);
         vk::DescriptorSet set(ctx_, pipelines_.back());
-        for (uint32_t b = 0; b < NB_BINDING_COUNT; ++b) set.bind(b, buffers_[b]);
+        for (uint32_t b = 0; b < NB_NEURAL_BINDING_END; ++b) set.bind(b, buffers_[b]);
         sets_.push_back(std::move(set));
     }
-    timer_ = vk::GpuTimer(ctx_, 64 + 8 * options_.max_depth);
+    timer_ = vk::GpuTimer(ctx_, 64 + (8 + (neural_ ? 3 * neural_->rounds() + 2 : 0)) * options_.max_depth);
     cmd_ = vk::CommandBuffer(ctx_, "wavefront");
 }
 
@@ -154,10 +173,14 @@ void WavefrontRenderer::record_pass(vk::CommandBuffer& cmd, size_t pass, const G
     case Dispatch::indirect_shadow:
         cmd.dispatch_indirect(buffers_[NB_BIND_COUNTERS], NB_COUNTERS_SHADOW_DISPATCH_OFFSET);
         break;
+    case Dispatch::indirect_pending:
+        cmd.dispatch_indirect(buffers_[NB_BIND_COUNTERS], NB_COUNTERS_PENDING_DISPATCH_OFFSET);
+        break;
     }
     cmd.end_pass();
     // queue_args writes dispatch arguments; everything else feeds the next pass's shader reads.
-    cmd.barrier(pass == QUEUE_ARGS ? vk::Barrier::compute_to_indirect : vk::Barrier::compute_to_compute);
+    cmd.barrier(pass == QUEUE_ARGS || pass == NEURAL_ARGS ? vk::Barrier::compute_to_indirect
+                                                          : vk::Barrier::compute_to_compute);
 }
 
 void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, uint32_t sample, uint32_t offset, uint32_t count) {
@@ -165,7 +188,18 @@ void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, uint32_t samp
     uint32_t q = 0;
     for (uint32_t depth = 0; depth < options_.max_depth; ++depth) {
         record_pass(cmd, QUEUE_ARGS, constants(q, depth, sample, offset, count, NB_ARGS_MODE_RAYS), Dispatch::single);
-        record_pass(cmd, TRAVERSE, constants(q, depth, sample, offset, count, 0), Dispatch::indirect_rays);
+        if (neural_) {
+            // Closest hits through triangles and neural leaves: queue a pair per ray, query, resume.
+            record_pass(cmd, NEURAL_TRAVERSE, constants(q, depth, sample, offset, count, 0), Dispatch::indirect_rays);
+            for (uint32_t round = 0; round < neural_->rounds(); ++round) {
+                record_pass(cmd, NEURAL_ARGS, constants(q, depth, sample, offset, count, 0), Dispatch::single);
+                record_pass(cmd, NEURAL_QUERY, constants(q, depth, sample, offset, count, 0), Dispatch::indirect_pending);
+                record_pass(cmd, NEURAL_TRAVERSE, constants(q, depth, sample, offset, count, 1), Dispatch::indirect_rays);
+            }
+            record_pass(cmd, NEURAL_TRAVERSE, constants(q, depth, sample, offset, count, 2), Dispatch::indirect_rays);
+        } else {
+            record_pass(cmd, TRAVERSE, constants(q, depth, sample, offset, count, 0), Dispatch::indirect_rays);
+        }
         record_pass(cmd, SHADE, constants(q, depth, sample, offset, count, 0), Dispatch::indirect_rays);
         if (features_.has_lights()) {
             record_pass(cmd, QUEUE_ARGS, constants(q, depth, sample, offset, count, NB_ARGS_MODE_SHADOW),
@@ -182,6 +216,7 @@ RenderResult WavefrontRenderer::render() {
     const uint32_t pixels = options_.width * options_.height;
     buffers_[NB_BIND_FILM].fill(0u);
     buffers_[NB_BIND_COUNTERS].fill(0u);
+    if (neural_) buffers_[NB_BIND_NEURAL_COUNTERS].fill(0u);
 
     std::vector<std::pair<std::string, double>> pass_ms;
     std::map<std::string, size_t> pass_index;
@@ -233,6 +268,14 @@ RenderResult WavefrontRenderer::render() {
     s.rays_secondary = counters.rays_secondary;
     s.rays_shadow = counters.rays_shadow;
     s.nonfinite_samples = counters.nonfinite_samples;
+    if (neural_) {
+        const GpuNeuralCounters nc = buffers_[NB_BIND_NEURAL_COUNTERS].download<GpuNeuralCounters>(1)[0];
+        s.neural_path = neural_->kernel().describe();
+        s.neural_queries = nc.queries_total;
+        s.neural_rounds = nc.rounds;
+        for (const auto& [name, ms] : pass_ms)
+            if (name == PASS_SHADERS[NEURAL_QUERY]) s.neural_query_ms += ms;
+    }
     for (size_t i = 0; i < result.image.pixel_count(); ++i) {
         const float* px = result.image.data.data() + i * 4;
         if (!std::isfinite(px[0]) || !std::isfinite(px[1]) || !std::isfinite(px[2])) ++s.nonfinite_pixels;

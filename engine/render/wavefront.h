@@ -5,6 +5,7 @@
 // The Vulkan context owns device things; the Scene/SceneAccel stay with the caller.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "engine/core/image.h"
 #include "engine/render/feature_set.h"
 #include "engine/render/gpu_scene.h"
+#include "engine/render/neural_stage.h"
 #include "shaders/shared/wavefront_gpu.h"
 #include "engine/scene/scene.h"
 #include "engine/vk/buffer.h"
@@ -29,6 +31,7 @@ struct RenderOptions {
     uint32_t seed = 0;
     uint32_t rr_start_depth = 3;     // Russian roulette from this segment on
     uint32_t max_wave_pixels = 1u << 20; // rays per queue; bounded by the device's storage range too
+    NeuralRenderOptions neural;      // hybrid (model) or classical-reference render of neural instances
 };
 
 struct RenderStats {
@@ -40,6 +43,18 @@ struct RenderStats {
     uint64_t rays_primary = 0, rays_secondary = 0, rays_shadow = 0;
     uint64_t nonfinite_samples = 0; // dropped by accumulate.comp
     uint64_t nonfinite_pixels = 0;  // in the resolved image (counted on the CPU; must be 0)
+    // Neural (hybrid renders): queries of path rays, rounds with queued pairs, the MLP path, and the
+    // GPU time of the neural query passes (queries/s = neural_queries / neural_query_ms).
+    std::string neural_path;
+    uint64_t neural_queries = 0, neural_rounds = 0;
+    double neural_query_ms = 0.0;
+    double neural_queries_per_ray() const {
+        const uint64_t r = rays_primary + rays_secondary;
+        return r ? double(neural_queries) / double(r) : 0.0;
+    }
+    double neural_queries_per_second() const {
+        return neural_query_ms > 0.0 ? double(neural_queries) / (neural_query_ms * 1.0e-3) : 0.0;
+    }
     uint64_t rays_total() const { return rays_primary + rays_secondary + rays_shadow; }
     double rays_per_second() const { return gpu_ms > 0.0 ? double(rays_total()) / (gpu_ms * 1.0e-3) : 0.0; }
 };
@@ -75,7 +90,7 @@ public:
 private:
     GpuPassConstants constants(uint32_t queue, uint32_t depth, uint32_t sample, uint32_t offset, uint32_t count,
                                uint32_t mode) const;
-    enum class Dispatch { items, single, indirect_rays, indirect_shadow };
+    enum class Dispatch { items, single, indirect_rays, indirect_shadow, indirect_pending };
     void record_pass(vk::CommandBuffer& cmd, size_t pass, const GpuPassConstants& pc, Dispatch dispatch,
                      uint64_t items = 0);
     void record_sample_wave(vk::CommandBuffer& cmd, uint32_t sample, uint32_t offset, uint32_t count);
@@ -90,6 +105,7 @@ private:
     std::vector<vk::Buffer> buffers_;          // indexed by NB_BIND_*
     std::vector<vk::ComputePipeline> pipelines_; // indexed by Pass
     std::vector<vk::DescriptorSet> sets_;
+    std::unique_ptr<NeuralStage> neural_; // hybrid render only
     vk::GpuTimer timer_;
     vk::CommandBuffer cmd_;
 };

@@ -117,13 +117,16 @@ void nb_traverse_triangle_instance(uint instance) {
     NB_TRAVERSE_BVH(blas_nodes, inst.blas_root, g_obj_org, inv_dir, nb_triangle_leaf)
 }
 
+// The neural leaf kind (N-BVH walk, pending pairs / inline shadow queries): lib/neural_traverse.glsl.
+#include "lib/neural_traverse.glsl"
+
 // TLAS leaf: instances first .. first+count-1 (TLAS leaf order), dispatched on their kind.
 void nb_instance_leaf(uint first, uint count) {
     for (uint k = 0u; k < count && !g_done; ++k) {
         uint instance = first + k;
         uint kind = instances[instance].kind;
-        if (kind == NB_INSTANCE_TRIANGLES) nb_traverse_triangle_instance(instance);
-        // NB_INSTANCE_NEURAL: handled by the neural leaf handler (next issue), only when NB_HAS_NEURAL.
+        if (kind == NB_INSTANCE_TRIANGLES && !g_nl_skip_triangles) nb_traverse_triangle_instance(instance);
+        else if (NB_HAS_NEURAL && kind == NB_INSTANCE_NEURAL) nb_traverse_neural_instance(instance);
     }
 }
 

@@ -72,4 +72,65 @@ NB_FN bool nb_neural_leaf_interval(vec3 org, vec3 inv_dir, vec3 lo, vec3 hi, NB_
 
 // fp16 <-> uint packing on the host matches unpackHalf2x16: element 2k in bits 0..15, 2k+1 in 16..31.
 
+// ---- Renderer integration (wavefront loop, engine/render/neural_stage.h) ---------------------------
+// The hit SOA's triangle word of a neural hit (shade.comp then reads the ray's GpuNeuralRayState).
+#define NB_NEURAL_TRIANGLE 0xFFFFFFFEu
+
+// Per path ray (one per slot of the queue being traced): the best neural hit so far and the ordering
+// key of the last leaf queried. Leaves are visited in increasing key = (max(t_entry, tmin), instance,
+// leaf): each round re-traverses the scene for the smallest key above the last one whose entry is still
+// in front of the best hit (triangle or neural), so overlapping leaves of one or several instances are
+// all queried in order and the closest accepted hit wins.
+#define NB_NRAY_TRACE 0u    // needs a traversal round
+#define NB_NRAY_PENDING 1u  // a (ray, leaf) pair is queued
+#define NB_NRAY_DONE 2u
+struct GpuNeuralRayState {
+    vec3 normal;    // world-space unit normal of the best neural hit
+    float best_t;   // NB_INF: none
+    vec3 albedo;
+    uint instance;  // neural instance of the best hit
+    float key_t;    // key of the last queued leaf
+    uint key_instance;
+    uint key_leaf;
+    uint status;    // NB_NRAY_*
+    float tri_t;    // closest triangle hit of round 0 (NB_INF: none)
+    uint tri_instance;
+    uint tri_triangle;
+    uint rounds;    // leaves queried so far
+};
+NB_STATIC_ASSERT(sizeof(GpuNeuralRayState) == 64, "GpuNeuralRayState layout");
+
+// Neural constants of a render (storage buffer, one struct).
+struct GpuNeuralParams {
+    GpuEncodingBox box;
+    uint root_primary;    // first GPU node of the N-BVH cut used by camera rays (--lod)
+    uint root_secondary;  // ... by rays after the first hit (--secondary-lod)
+    float roughness;      // material constants of neural surfaces (--neural-roughness/--neural-metallic)
+    float metallic;
+    float threshold;      // visibility threshold
+    uint max_rounds;      // leaves queried per ray at most (then the best hit so far is kept)
+    uint pad0;
+    uint pad1;
+};
+NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 64, "GpuNeuralParams layout");
+
+struct GpuNeuralCounters {
+    uint pending_active;  // pairs the current neural_query dispatch processes
+    uint queries_total;   // statistics: queries of the render (path rays)
+    uint shadow_queries;  // statistics: inline queries of shadow rays
+    uint rounds;          // statistics: rounds with at least one pair
+};
+NB_STATIC_ASSERT(sizeof(GpuNeuralCounters) == 16, "GpuNeuralCounters layout");
+
+// Bindings of the renderer's set 0 after shared/scene_gpu.h's NB_BINDING_COUNT (20).
+#define NB_BIND_NEURAL_LEVELS 20u
+#define NB_BIND_NEURAL_GRID 21u
+#define NB_BIND_NEURAL_MLP 22u
+#define NB_BIND_NBVH_NODES 23u
+#define NB_BIND_NBVH_BOUNDS 24u
+#define NB_BIND_NEURAL_STATE 25u
+#define NB_BIND_NEURAL_PARAMS 26u
+#define NB_BIND_NEURAL_COUNTERS 27u
+#define NB_NEURAL_BINDING_END 28u
+
 #endif

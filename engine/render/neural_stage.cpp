@@ -1,0 +1,110 @@
+#include "engine/render/neural_stage.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "engine/core/error.h"
+#include "engine/core/log.h"
+#include "shaders/shared/scene_gpu.h"
+#include "shaders/shared/wavefront_gpu.h"
+
+namespace nbvh::render {
+
+void validate(const NeuralRenderOptions& o, const Scene& scene) {
+    if (!(o.roughness >= 0.0f && o.roughness <= 1.0f)) throw Error("--neural-roughness must be in [0, 1]");
+    if (!(o.metallic >= 0.0f && o.metallic <= 1.0f)) throw Error("--neural-metallic must be in [0, 1]");
+    if (o.max_rounds == 0 || o.max_rounds > 256) throw Error("--neural-max-leaves must be in 1..256");
+    if (!(o.threshold > 0.0f && o.threshold < 1.0f)) throw Error("the visibility threshold must be in (0, 1)");
+    bool any = false;
+    for (const Instance& i : scene.instances) any = any || i.neural;
+    if ((o.model || o.classical) && !any) throw Error("the scene has no neural instance (mark one with --neural)");
+    if (o.model) {
+        const uint32_t lods = std::max(1u, o.model->lod_count);
+        if (o.lod >= lods) throw Error(strfmt("--lod %u: the model has %u level(s) of detail (0..%u)", o.lod, lods, lods - 1));
+        if (o.secondary_lod >= int32_t(lods))
+            throw Error(strfmt("--secondary-lod %d: the model has %u level(s) of detail (0..%u)", o.secondary_lod,
+                               lods, lods - 1));
+    }
+}
+
+uint32_t mark_neural_instances(const Scene& scene, GpuSceneData& data) {
+    uint32_t n = 0;
+    for (size_t gi = 0; gi < data.instance_to_scene.size() && gi < data.instances.size(); ++gi) {
+        if (scene.instances[data.instance_to_scene[gi]].neural) {
+            data.instances[gi].kind = NB_INSTANCE_NEURAL;
+            ++n;
+        }
+    }
+    return n;
+}
+
+void apply_classical_materials(const Scene& scene, GpuSceneData& data, float roughness, float metallic) {
+    std::map<uint32_t, uint32_t> copy_of; // original material -> its neural-constants copy
+    std::vector<bool> done(scene.meshes.size(), false);
+    for (size_t gi = 0; gi < data.instance_to_scene.size() && gi < data.instances.size(); ++gi) {
+        const Instance& inst = scene.instances[data.instance_to_scene[gi]];
+        if (!inst.neural || inst.mesh >= scene.meshes.size() || done[inst.mesh]) continue;
+        done[inst.mesh] = true;
+        const uint32_t first = data.instances[gi].first_triangle;
+        const uint32_t count = scene.meshes[inst.mesh].triangle_count();
+        for (uint32_t t = first; t < first + count && t < data.triangles.size(); ++t) {
+            const uint32_t m = data.triangles[t].material;
+            auto it = copy_of.find(m);
+            if (it == copy_of.end()) {
+                GpuMaterial c = data.materials[m];
+                c.roughness = roughness;
+                c.metallic = metallic;
+                c.metallic_roughness_tex.texture = -1;
+                c.transmission = 0.0f;
+                it = copy_of.emplace(m, uint32_t(data.materials.size())).first;
+                data.materials.push_back(c);
+            }
+            data.triangles[t].material = it->second;
+        }
+    }
+}
+
+NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const NeuralRenderOptions& o,
+                         uint32_t ray_capacity)
+    : ctx_(ctx), model_(ctx, model), kernel_(choose_neural_kernel(ctx.features(), o.path)),
+      rounds_(o.max_rounds), capacity_(ray_capacity) {
+    params_.box = model_.box();
+    params_.root_primary = model_.lod_root(o.lod);
+    params_.root_secondary = model_.lod_root(o.secondary_lod < 0 ? o.lod : uint32_t(o.secondary_lod));
+    params_.roughness = o.roughness;
+    params_.metallic = o.metallic;
+    params_.threshold = o.threshold;
+    params_.max_rounds = o.max_rounds;
+}
+
+const char* NeuralStage::query_shader() const {
+    if (kernel_.path == NeuralPath::scalar) return "passes/neural_query_scalar.comp";
+    return kernel_.fp32_accumulate ? "passes/neural_query_coop32.comp" : "passes/neural_query_coop16.comp";
+}
+
+void NeuralStage::install(std::vector<vk::Buffer>& buffers) {
+    if (buffers.size() < NB_NEURAL_BINDING_END) buffers.resize(NB_NEURAL_BINDING_END);
+    model_.move_into(buffers[NB_BIND_NEURAL_LEVELS], buffers[NB_BIND_NEURAL_GRID], buffers[NB_BIND_NEURAL_MLP],
+                     buffers[NB_BIND_NBVH_NODES], buffers[NB_BIND_NBVH_BOUNDS]);
+    buffers[NB_BIND_PENDING_LEAVES] = vk::Buffer(ctx_, uint64_t(std::max(capacity_, 1u)) * sizeof(GpuPendingLeaf),
+                                                 vk::MemoryKind::device, 0, "pending leaves");
+    buffers[NB_BIND_NEURAL_STATE] = vk::Buffer(ctx_, uint64_t(std::max(capacity_, 1u)) * sizeof(GpuNeuralRayState),
+                                               vk::MemoryKind::device, 0, "neural ray state");
+    buffers[NB_BIND_NEURAL_PARAMS] = vk::make_buffer(ctx_, std::vector<GpuNeuralParams>{params_}, "neural params");
+    buffers[NB_BIND_NEURAL_COUNTERS] =
+        vk::Buffer(ctx_, sizeof(GpuNeuralCounters), vk::MemoryKind::device, 0, "neural counters");
+    buffers[NB_BIND_PENDING_LEAVES].fill(0u);
+    buffers[NB_BIND_NEURAL_STATE].fill(0u);
+    buffers[NB_BIND_NEURAL_COUNTERS].fill(0u);
+}
+
+void NeuralStage::install_placeholders(const vk::Context& ctx, std::vector<vk::Buffer>& buffers) {
+    if (buffers.size() < NB_NEURAL_BINDING_END) buffers.resize(NB_NEURAL_BINDING_END);
+    for (uint32_t b = NB_BIND_NEURAL_LEVELS; b < NB_NEURAL_BINDING_END; ++b) {
+        buffers[b] = vk::Buffer(ctx, 64, vk::MemoryKind::device, 0, "neural placeholder");
+        buffers[b].fill(0u);
+    }
+}
+
+} // namespace nbvh::render

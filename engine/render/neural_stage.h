@@ -1,0 +1,70 @@
+// The neural part of the wavefront renderer (issue 4): what WavefrontRenderer needs to render a hybrid
+// scene (neural instances traced through their N-BVH and queried through the network) or its classical
+// reference (the same instances traced from their triangles with the neural material constants).
+//
+// Per path-ray bounce the renderer records (engine/render/README.md):
+//   neural_traverse(mode 0) -> [neural_args -> neural_query -> neural_traverse(mode 1)] x rounds
+//   -> neural_traverse(mode 2) -> shade
+// instead of traverse; shadow rays query neural leaves inline (scalar path) in passes/shadow.comp.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "engine/neural/model_file.h"
+#include "engine/render/gpu_scene.h"
+#include "engine/render/neural_model_gpu.h"
+#include "engine/scene/scene.h"
+#include "engine/vk/buffer.h"
+#include "engine/vk/context.h"
+
+namespace nbvh::render {
+
+struct NeuralRenderOptions {
+    const NeuralModel* model = nullptr; // hybrid render when set (and not classical)
+    bool classical = false;             // reference: neural instances as triangles, neural material constants
+    NeuralPath path = NeuralPath::automatic;
+    uint32_t lod = 0;                   // N-BVH cut of camera rays (0 = finest)
+    int32_t secondary_lod = -1;         // cut after the first hit (-1: same as lod)
+    float roughness = 0.5f;             // material constants of neural surfaces
+    float metallic = 0.0f;
+    uint32_t max_rounds = 16;           // leaves queried per ray at most
+    float threshold = NB_VISIBILITY_THRESHOLD;
+};
+
+// Throws nbvh::Error on out-of-range constants (roughness/metallic outside [0,1], rounds 0 or > 256,
+// LoDs beyond the model's, a model with no neural instance in the scene).
+void validate(const NeuralRenderOptions& options, const Scene& scene);
+
+// Marks instances flagged neural as NB_INSTANCE_NEURAL (hybrid render). Returns how many.
+uint32_t mark_neural_instances(const Scene& scene, GpuSceneData& data);
+// Classical reference: neural meshes' triangles get copies of their materials with the neural
+// roughness/metallic (and no transmission), so both renders shade with the same constants.
+void apply_classical_materials(const Scene& scene, GpuSceneData& data, float roughness, float metallic);
+
+class NeuralStage {
+public:
+    NeuralStage(const vk::Context& ctx, const NeuralModel& model, const NeuralRenderOptions& options,
+                uint32_t ray_capacity);
+
+    // Moves the neural buffers into `buffers` (indexed by binding, resized to NB_NEURAL_BINDING_END):
+    // NB_BIND_NEURAL_*, NB_BIND_NBVH_*, and the pending-leaf queue at NB_BIND_PENDING_LEAVES.
+    void install(std::vector<vk::Buffer>& buffers);
+    // Small placeholders for every neural binding (scenes rendered without a model).
+    static void install_placeholders(const vk::Context& ctx, std::vector<vk::Buffer>& buffers);
+
+    const NeuralKernelChoice& kernel() const { return kernel_; }
+    const char* query_shader() const;
+    uint32_t rounds() const { return rounds_; }
+    const GpuNeuralParams& params() const { return params_; }
+
+private:
+    const vk::Context& ctx_;
+    NeuralModelGpu model_;
+    NeuralKernelChoice kernel_;
+    GpuNeuralParams params_{};
+    uint32_t rounds_ = 0;
+    uint32_t capacity_ = 0;
+};
+
+} // namespace nbvh::render

@@ -1,0 +1,24 @@
+// Body of passes/neural_query_coop{16,32}.comp: the neural query pass through the fused
+// cooperative-matrix MLP (64 pairs per workgroup; the includer defines NB_COOP_ACC_BITS).
+#include "lib/bindings.glsl"
+#define NB_NEURAL_MLP_AS_HALF 1
+#include "lib/neural_bindings.glsl"
+#include "lib/neural_grid.glsl"
+#include "lib/neural_mlp_coopmat.glsl"
+#include "lib/neural_query_pass.glsl"
+
+layout(local_size_x = NB_NEURAL_GROUP) in;
+
+void main() {
+    NbPendingQuery r = nb_load_pending(gl_GlobalInvocationID.x);
+    vec3 p0, p1, p2;
+    nb_segment_points(neural_params.box, r.org, r.dir, r.pl.t_enter, r.pl.t_exit, p0, p1, p2);
+    nb_coop_stage_features(gl_LocalInvocationID.x, r.valid, p0, p1, p2);
+    barrier();
+    nb_mlp_forward_coopmat(); // whole workgroup, uniform control flow
+    if (!r.valid) return;
+    float y[NB_MLP_OUTPUTS];
+    for (uint k = 0u; k < NB_MLP_OUTPUTS; ++k)
+        y[k] = nb_sigmoid(nb_sh_y[gl_LocalInvocationID.x * NB_MLP_OUTPUTS_PADDED + k]);
+    nb_apply_neural_result(r, y);
+}

@@ -1,0 +1,19 @@
+// One invocation between a neural traversal round and the neural query pass: hands the pairs queued so
+// far to the query pass (pending_active), empties the queue for the next round, writes the indirect
+// dispatch arguments (NB_NEURAL_GROUP pairs per workgroup) and counts queries for --stats.
+#version 460
+#include "lib/bindings.glsl"
+#include "lib/neural_bindings.glsl"
+
+layout(local_size_x = 1) in;
+
+void main() {
+    uint n = counters.pending_count;
+    counters.pending_count = 0u;
+    neural_counters.pending_active = n;
+    neural_counters.queries_total += n;
+    if (n > 0u) neural_counters.rounds += 1u;
+    counters.pending_dispatch.x = (n + NB_NEURAL_GROUP - 1u) / NB_NEURAL_GROUP;
+    counters.pending_dispatch.y = 1u;
+    counters.pending_dispatch.z = 1u;
+}

@@ -1,0 +1,4 @@
+// Neural query pass, fused cooperative-matrix MLP with fp16 accumulators.
+#version 460
+#define NB_COOP_ACC_BITS 16
+#include "lib/neural_query_coopmat_main.glsl"
