@@ -1,6 +1,7 @@
 // nbvh train SCENE: learns the N-BVH of the scene's neural asset and writes MODEL.nbvh.
 // SCENE is a glTF file or "default" (the built-in demo scene, assets/). Which assets are neural follows
 // ARCHITECTURE.md: the nodes of a "*_neural" glTF scene, or --neural GLOB.
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -30,6 +31,7 @@ struct TrainArgs {
     std::optional<uint32_t> nodes, hash_log2, steps, batch;
     uint32_t lods = 1, threads = 0;
     uint64_t seed = 1337;
+    bool deterministic = false; // CUDA backend: order-independent gradient sums (trainer/cuda/README.md)
 };
 
 BackendChoice parse_backend(const std::string& s) {
@@ -79,6 +81,7 @@ void run_train(const TrainArgs& a) {
                                 ? (a.scene == "default" ? std::string("default.nbvh")
                                                         : std::filesystem::path(a.scene).stem().string() + ".nbvh")
                                 : a.out;
+    if (a.deterministic) setenv("NBVH_CUDA_DETERMINISTIC", "1", 1); // read by the CUDA backend
     std::unique_ptr<TrainerBackend> be = make_backend(backend, asset, opt);
     const SplitSchedule schedule = make_split_schedule(opt);
     log_info("training '%s' (%u triangles) on %s: %u steps x %u rays, target %u nodes, hash 2^%u, %u LoD(s); %s",
@@ -122,6 +125,7 @@ void add_train_command(CLI::App& app) {
     cmd->add_option("--lods", args->lods, "cuts kept as levels of detail (1..8)");
     cmd->add_option("--seed", args->seed, "random seed (network init and rays)");
     cmd->add_option("--threads", args->threads, "CPU backend threads (default: all cores)");
+    cmd->add_flag("--deterministic", args->deterministic, "CUDA backend: bit-reproducible steps (slower)");
     cmd->add_option("--log", args->log_csv, "write a CSV log of the losses and node count per step");
     cmd->callback([args] { run_train(*args); });
 }
