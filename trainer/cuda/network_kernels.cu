@@ -23,7 +23,7 @@ constexpr int kTile = 16 * kWarps; // samples per block tile
 constexpr int kLdIn = NB_MLP_INPUTS + 8;  // 104 halves (padding against bank conflicts)
 constexpr int kLdH = NB_MLP_WIDTH + 8;    // 72
 constexpr int kLdO = 16 + 8;              // 24
-constexpr int kLdS = NB_MLP_WIDTH + 4;    // 68 floats
+constexpr int kLdS = 16 + 4;              // 20 floats (per-warp 16 x 16 fp32 staging)
 
 constexpr size_t kSmemW = NB_MLP_WEIGHT_COUNT * 2;
 constexpr size_t kSmemX0 = size_t(kTile) * kLdIn * 2;
@@ -98,18 +98,31 @@ __global__ void k_grid_backward_coarse(DevNetwork net, DevBatch b, uint32_t coar
         }
     }
     __syncthreads();
-    for (uint32_t v = threadIdx.x; v < coarse_values; v += blockDim.x)
-        if (acc_s[v] != 0.0f) atomicAdd(net.grid_grad + v, acc_s[v]);
+    // One float4 add per touched entry (coarse levels start at entry 0; coarse_values is a multiple of 4).
+    for (uint32_t e = threadIdx.x; e < coarse_values / 4; e += blockDim.x) {
+        const float4 v = reinterpret_cast<const float4*>(acc_s)[e];
+        if (v.x == 0.0f && v.y == 0.0f && v.z == 0.0f && v.w == 0.0f) continue;
+#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900
+        atomicAdd(reinterpret_cast<float4*>(net.grid_grad) + e, v);
+#else
+        float* dst = net.grid_grad + size_t(e) * 4;
+        atomicAdd(dst + 0, v.x);
+        atomicAdd(dst + 1, v.y);
+        atomicAdd(dst + 2, v.z);
+        atomicAdd(dst + 3, v.w);
+#endif
+    }
 }
 
-// Grid backward: one thread per (sample, point, level), 8 corners x 4 features. Levels below
-// `first_level` were done by k_grid_backward_coarse.
+// Grid backward: one thread per (sample, point, level >= first_level), 8 corners x 4 features. Levels below
+// `first_level` were done by k_grid_backward_coarse (threads are mapped to the remaining levels only, so no
+// warp lane idles on them).
 __global__ void k_grid_backward(DevNetwork net, DevBatch b, int deterministic, uint32_t first_level, uint32_t* flag) {
     const uint32_t tid = blockIdx.x * blockDim.x + threadIdx.x;
-    const uint32_t per = NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS;
+    const uint32_t levels = NB_GRID_MAX_LEVELS - first_level, per = NB_SEGMENT_POINTS * levels;
     if (tid >= b.n * per) return;
-    const uint32_t i = tid / per, r = tid % per, k = r / NB_GRID_MAX_LEVELS, l = r % NB_GRID_MAX_LEVELS;
-    if (l < first_level || b.leaf[i] < 0) return;
+    const uint32_t i = tid / per, r = tid % per, k = r / levels, l = first_level + r % levels;
+    if (b.leaf[i] < 0) return;
     const float4 df = *reinterpret_cast<const float4*>(b.dfeatures + size_t(i) * NB_MLP_INPUTS + nb_feature_slot(k, l, 0));
     if (!isfinite(df.x + df.y + df.z + df.w)) { atomicOr(flag, NB_GUARD_GRADIENT); return; }
     if (df.x == 0.0f && df.y == 0.0f && df.z == 0.0f && df.w == 0.0f) return;
@@ -150,61 +163,95 @@ using FragAc = wmma::fragment<wmma::matrix_a, 16, 16, 16, __half, wmma::col_majo
 using FragBc = wmma::fragment<wmma::matrix_b, 16, 16, 16, __half, wmma::col_major>;
 using FragBr = wmma::fragment<wmma::matrix_b, 16, 16, 16, __half, wmma::row_major>;
 using FragC = wmma::fragment<wmma::accumulator, 16, 16, 16, float>;
+using FragCh = wmma::fragment<wmma::accumulator, 16, 16, 16, __half>;
+// ReLU, the fp16 rounding and the ReLU mask are applied on the accumulator fragments in registers: element
+// i of an fp32 and of an fp16 accumulator fragment is the same matrix element (both are the m16n8k16 C
+// layout on sm_70+), which the CPU cross-check of every activation and gradient (tests/cuda) verifies.
+static_assert(FragC::num_elements == FragCh::num_elements, "accumulator fragments must match");
 
-// Y(16 x 64) = X(16 x K) W_m^T for one warp, into staging (fp32).
-__device__ void layer_forward(const __half* x, int ldx, const __half* w, int k_in, float* stage) {
+// H(16 x 64) = fp16(relu(X(16 x 16*KT) W_m^T)) for one warp (rounding point R3 of mlp.h), stored as fp16.
+// The A fragments of the warp's rows are loaded once and reused for the 4 output column tiles.
+template <int KT>
+__device__ void layer_forward_relu(const __half* x, int ldx, const __half* w, __half* out) {
+    FragA a[KT];
+#pragma unroll
+    for (int kk = 0; kk < KT; ++kk) wmma::load_matrix_sync(a[kk], x + kk * 16, ldx);
+#pragma unroll
     for (int j = 0; j < 4; ++j) {
         FragC acc;
         wmma::fill_fragment(acc, 0.0f);
-        for (int kk = 0; kk < k_in / 16; ++kk) {
-            FragA a;
+#pragma unroll
+        for (int kk = 0; kk < KT; ++kk) {
             FragBc bm;
-            wmma::load_matrix_sync(a, x + kk * 16, ldx);
-            wmma::load_matrix_sync(bm, w + size_t(j) * 16 * k_in + kk * 16, k_in); // W^T as col-major
-            wmma::mma_sync(acc, a, bm, acc);
+            wmma::load_matrix_sync(bm, w + size_t(j) * 16 * (16 * KT) + kk * 16, 16 * KT); // W^T as col-major
+            wmma::mma_sync(acc, a[kk], bm, acc);
         }
-        wmma::store_matrix_sync(stage + j * 16, acc, kLdS, wmma::mem_row_major);
+        FragCh h;
+#pragma unroll
+        for (int e = 0; e < FragC::num_elements; ++e) h.x[e] = __float2half_rn(fmaxf(acc.x[e], 0.0f));
+        wmma::store_matrix_sync(out + j * 16, h, kLdH, wmma::mem_row_major);
     }
 }
 
-// dX(16 x n_out*16) = dZ(16 x k_rows) W_m (k_rows x cols) for one warp. W_m row-major (rows x cols).
-__device__ void layer_backward_data(const __half* dz, int lddz, const __half* w, int rows, int cols, int j0, int j1,
-                                    float* out, int ldo) {
-    for (int j = j0; j < j1; ++j) {
-        FragC acc;
-        wmma::fill_fragment(acc, 0.0f);
-        for (int kk = 0; kk < rows / 16; ++kk) {
-            FragA a;
+// dX(16 x 16*NJ) = dZ(16 x 16*KT) W_m (16*KT x cols) for one warp, into registers. W_m row-major.
+template <int KT, int NJ>
+__device__ void layer_backward_data(const __half* dz, int lddz, const __half* w, int cols, FragC (&out)[NJ]) {
+    FragA a[KT];
+#pragma unroll
+    for (int kk = 0; kk < KT; ++kk) wmma::load_matrix_sync(a[kk], dz + kk * 16, lddz);
+#pragma unroll
+    for (int j = 0; j < NJ; ++j) {
+        wmma::fill_fragment(out[j], 0.0f);
+#pragma unroll
+        for (int kk = 0; kk < KT; ++kk) {
             FragBr bm;
-            wmma::load_matrix_sync(a, dz + kk * 16, lddz);
             wmma::load_matrix_sync(bm, w + size_t(kk) * 16 * cols + j * 16, cols);
-            wmma::mma_sync(acc, a, bm, acc);
+            wmma::mma_sync(out[j], a[kk], bm, out[j]);
         }
-        wmma::store_matrix_sync(out + (j - j0) * 16, acc, ldo, wmma::mem_row_major);
     }
 }
 
-// dW_m (rows x cols, row-major in `slice`) += dZ^T (rows x 128) X (128 x cols), tiles split over warps.
-__device__ void weight_grad(const __half* dz, int lddz, const __half* x, int ldx, int rows, int cols, float* slice,
-                            int warp) {
-    const int tiles_c = cols / 16, tiles = (rows / 16) * tiles_c;
-    for (int t = warp; t < tiles; t += kWarps) {
-        const int tr = t / tiles_c, tc = t % tiles_c;
-        FragC acc;
-        float* dst = slice + size_t(tr) * 16 * cols + tc * 16;
-        wmma::load_matrix_sync(acc, dst, cols, wmma::mem_row_major);
-        for (int kk = 0; kk < kTile / 16; ++kk) {
-            FragAc a;
-            FragBr bm;
-            wmma::load_matrix_sync(a, dz + size_t(kk) * 16 * lddz + tr * 16, lddz); // dZ^T: col-major view
-            wmma::load_matrix_sync(bm, x + size_t(kk) * 16 * ldx + tc * 16, ldx);
-            wmma::mma_sync(acc, a, bm, acc);
-        }
-        wmma::store_matrix_sync(dst, acc, cols, wmma::mem_row_major);
+// dZ_m = dX ⊙ relu'(H), in place over the warp's 16 rows of H (ReLU'(0) = 0, as tcnn), rounded to fp16.
+__device__ void relu_mask_in_place(__half* hz, const FragC (&dx)[4]) {
+#pragma unroll
+    for (int j = 0; j < 4; ++j) {
+        FragCh h;
+        wmma::load_matrix_sync(h, hz + j * 16, kLdH, wmma::mem_row_major);
+#pragma unroll
+        for (int e = 0; e < FragC::num_elements; ++e)
+            h.x[e] = __float2half_rn(__half2float(h.x[e]) > 0.0f ? dx[j].x[e] : 0.0f);
+        wmma::store_matrix_sync(hz + j * 16, h, kLdH, wmma::mem_row_major);
     }
+}
+
+// Weight gradient tiles of one warp: dW_m[tr, tc0 .. tc0+TPW) += dZ^T (16 x 128) X (128 x 16*TPW), K = the whole
+// tile. The accumulators stay in registers across all tiles of the block (a fixed order: deterministic).
+template <int TPW>
+__device__ void weight_grad(const __half* dz, int lddz, const __half* x, int ldx, int tr, int tc0, FragC (&acc)[TPW]) {
+#pragma unroll 2
+    for (int kk = 0; kk < kTile / 16; ++kk) {
+        FragAc a;
+        wmma::load_matrix_sync(a, dz + size_t(kk) * 16 * lddz + tr * 16, lddz); // dZ^T: col-major view
+#pragma unroll
+        for (int q = 0; q < TPW; ++q) {
+            FragBr bm;
+            wmma::load_matrix_sync(bm, x + size_t(kk) * 16 * ldx + (tc0 + q) * 16, ldx);
+            wmma::mma_sync(acc[q], a, bm, acc[q]);
+        }
+    }
+}
+
+template <int TPW>
+__device__ void store_weight_grad(float* dst, int cols, int tr, int tc0, FragC (&acc)[TPW]) {
+#pragma unroll
+    for (int q = 0; q < TPW; ++q)
+        wmma::store_matrix_sync(dst + size_t(tr) * 16 * cols + (tc0 + q) * 16, acc[q], cols, wmma::mem_row_major);
 }
 
 __device__ float sgnf(float x) { return x > 0.0f ? 1.0f : (x < 0.0f ? -1.0f : 0.0f); }
+
+static_assert(NB_MLP_INPUTS == 96 && NB_MLP_WIDTH == 64 && NB_MLP_HIDDEN_LAYERS == 4 && kWarps == 8,
+              "k_mlp's warp-to-tile assignment is written for 96 -> 64x4 -> 16 and 8 warps");
 
 __global__ void __launch_bounds__(kWarps * 32, 1)
 k_mlp(DevNetwork net, DevBatch b, LossParams lp, float* slices, uint32_t* flag) {
@@ -219,6 +266,21 @@ k_mlp(DevNetwork net, DevBatch b, LossParams lp, float* slices, uint32_t* flag) 
     const int warp = threadIdx.x / 32, lane = threadIdx.x % 32;
     float* stage = sS + warp * 16 * kLdS;
     float* slice = slices + size_t(blockIdx.x) * NB_MLP_WEIGHT_COUNT;
+
+    // Weight-gradient tiles owned by this warp (fixed for the whole kernel):
+    //   W0 (64 x 96 = 4 x 6 tiles): row warp/2, columns 3*(warp%2) .. +3;
+    //   W1..W3 (4 x 4 tiles): row warp/2, columns 2*(warp%2) .. +2;  W4 (16 x 64 = 1 x 4 tiles): warps 0..3.
+    const int tr = warp / 2, tc0_in = 3 * (warp % 2), tc0_h = 2 * (warp % 2);
+    FragC g0[3], g1[2], g2[2], g3[2], g4[1];
+#pragma unroll
+    for (int q = 0; q < 3; ++q) wmma::fill_fragment(g0[q], 0.0f);
+#pragma unroll
+    for (int q = 0; q < 2; ++q) {
+        wmma::fill_fragment(g1[q], 0.0f);
+        wmma::fill_fragment(g2[q], 0.0f);
+        wmma::fill_fragment(g3[q], 0.0f);
+    }
+    wmma::fill_fragment(g4[0], 0.0f);
 
     for (int i = threadIdx.x; i < int(NB_MLP_WEIGHT_COUNT / 8); i += blockDim.x)
         reinterpret_cast<uint4*>(sW)[i] = reinterpret_cast<const uint4*>(net.mlp_h)[i];
@@ -237,14 +299,10 @@ k_mlp(DevNetwork net, DevBatch b, LossParams lp, float* slices, uint32_t* flag) 
         }
         __syncwarp();
         // Forward, hidden layers: H_{m+1} = fp16(relu(X_m W_m^T)) (rounding point R3 of mlp.h).
-        for (int m = 0; m < 4; ++m) {
-            const __half* x = m == 0 ? sX0 + row0 * kLdIn : sH[m - 1] + row0 * kLdH;
-            layer_forward(x, m == 0 ? kLdIn : kLdH, sW + nb_mlp_layer_offset(m), nb_mlp_layer_inputs(m), stage);
-            __syncwarp();
-            for (int e = lane; e < 16 * 64; e += 32) {
-                const int r = e / 64, c = e % 64;
-                sH[m][(row0 + r) * kLdH + c] = __float2half_rn(fmaxf(stage[r * kLdS + c], 0.0f));
-            }
+        layer_forward_relu<6>(sX0 + row0 * kLdIn, kLdIn, sW + nb_mlp_layer_offset(0), sH[0] + row0 * kLdH);
+        __syncwarp();
+        for (int m = 1; m < 4; ++m) {
+            layer_forward_relu<4>(sH[m - 1] + row0 * kLdH, kLdH, sW + nb_mlp_layer_offset(m), sH[m] + row0 * kLdH);
             __syncwarp();
         }
         // Output layer (16 rows, 8 used): fp32 pre-activation (R4), sigmoid, loss, dZ4.
@@ -315,30 +373,32 @@ k_mlp(DevNetwork net, DevBatch b, LossParams lp, float* slices, uint32_t* flag) 
             }
             __syncwarp();
         }
-        // Backward. dX4 = dZ4 W4 (16 x 64) into staging.
-        layer_backward_data(sO + row0 * kLdO, kLdO, sW + nb_mlp_layer_offset(4), 16, NB_MLP_WIDTH, 0, 4, stage, kLdS);
+        // Backward. dX4 = dZ4 W4 (16 x 64), kept in registers.
+        FragC dx[4];
+        layer_backward_data<1, 4>(sO + row0 * kLdO, kLdO, sW + nb_mlp_layer_offset(4), NB_MLP_WIDTH, dx);
         __syncthreads();
-        weight_grad(sO, kLdO, sH[3], kLdH, 16, NB_MLP_WIDTH, slice + nb_mlp_layer_offset(4), warp);
+        if (warp < 4) weight_grad<1>(sO, kLdO, sH[3], kLdH, 0, warp, g4);
         for (int m = 3; m >= 0; --m) {
             __syncthreads(); // dW_{m+1} has read H_{m+1} (= sH[m]); it now becomes dZ_m
             __half* hz = sH[m] + row0 * kLdH;
-            for (int e = lane; e < 16 * 64; e += 32) {
-                const int r = e / 64, c = e % 64;
-                const bool active = __half2float(hz[r * kLdH + c]) > 0.0f; // ReLU'(0) = 0, as tcnn
-                hz[r * kLdH + c] = __float2half_rn(active ? stage[r * kLdS + c] : 0.0f);
-            }
+            relu_mask_in_place(hz, dx);
             __syncwarp();
             const __half* w = sW + nb_mlp_layer_offset(m);
             if (m > 0) {
-                layer_backward_data(hz, kLdH, w, NB_MLP_WIDTH, NB_MLP_WIDTH, 0, 4, stage, kLdS);
+                layer_backward_data<4, 4>(hz, kLdH, w, NB_MLP_WIDTH, dx);
             } else {
                 // dL/dfeatures straight to global memory (fp32, loss-scaled), rows past the batch skipped.
+                FragC dxin[6];
+                layer_backward_data<4, 6>(hz, kLdH, w, NB_MLP_INPUTS, dxin);
                 float* out = b.dfeatures + size_t(s0) * NB_MLP_INPUTS;
                 if (s0 + 16 <= b.n) {
-                    layer_backward_data(hz, kLdH, w, NB_MLP_WIDTH, NB_MLP_INPUTS, 0, 6, out, NB_MLP_INPUTS);
+#pragma unroll
+                    for (int j = 0; j < 6; ++j)
+                        wmma::store_matrix_sync(out + j * 16, dxin[j], NB_MLP_INPUTS, wmma::mem_row_major);
                 } else {
+#pragma unroll
                     for (int j = 0; j < 6; ++j) {
-                        layer_backward_data(hz, kLdH, w, NB_MLP_WIDTH, NB_MLP_INPUTS, j, j + 1, stage, kLdS);
+                        wmma::store_matrix_sync(stage, dxin[j], kLdS, wmma::mem_row_major);
                         __syncwarp();
                         for (int e = lane; e < 256; e += 32) {
                             const int r = e / 16, c = e % 16;
@@ -349,12 +409,19 @@ k_mlp(DevNetwork net, DevBatch b, LossParams lp, float* slices, uint32_t* flag) 
                 }
             }
             __syncthreads(); // all dZ_m rows written
-            const __half* xm = m == 0 ? sX0 : sH[m - 1];
-            weight_grad(sH[m], kLdH, xm, m == 0 ? kLdIn : kLdH, NB_MLP_WIDTH, nb_mlp_layer_inputs(m),
-                        slice + nb_mlp_layer_offset(m), warp);
+            if (m == 3) weight_grad<2>(sH[3], kLdH, sH[2], kLdH, tr, tc0_h, g3);
+            else if (m == 2) weight_grad<2>(sH[2], kLdH, sH[1], kLdH, tr, tc0_h, g2);
+            else if (m == 1) weight_grad<2>(sH[1], kLdH, sH[0], kLdH, tr, tc0_h, g1);
+            else weight_grad<3>(sH[0], kLdH, sX0, kLdIn, tr, tc0_in, g0);
         }
         __syncthreads(); // before the next tile overwrites the buffers
     }
+    // The block's slice of the MLP gradient (summed over blocks in block order by k_reduce_mlp).
+    store_weight_grad<3>(slice + nb_mlp_layer_offset(0), NB_MLP_INPUTS, tr, tc0_in, g0);
+    store_weight_grad<2>(slice + nb_mlp_layer_offset(1), NB_MLP_WIDTH, tr, tc0_h, g1);
+    store_weight_grad<2>(slice + nb_mlp_layer_offset(2), NB_MLP_WIDTH, tr, tc0_h, g2);
+    store_weight_grad<2>(slice + nb_mlp_layer_offset(3), NB_MLP_WIDTH, tr, tc0_h, g3);
+    if (warp < 4) store_weight_grad<1>(slice + nb_mlp_layer_offset(4), NB_MLP_WIDTH, 0, warp, g4);
 }
 
 } // namespace
@@ -367,7 +434,6 @@ void launch_encode(const DevNetwork& net, const DevBatch& b, cudaStream_t s) {
 
 void launch_grid_backward(const DevNetwork& net, const DevBatch& b, bool deterministic, uint32_t* flag,
                           cudaStream_t s) {
-    const uint32_t n = b.n * NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS;
     // Coarse levels: the leading levels (offset 0..) whose values fit the shared-memory accumulator.
     uint32_t coarse = 0, values = 0;
     while (!deterministic && coarse < NB_GRID_MAX_LEVELS &&
@@ -388,6 +454,8 @@ void launch_grid_backward(const DevNetwork& net, const DevBatch& b, bool determi
         k_grid_backward_coarse<<<2 * sms, 512, values * 4, s>>>(net, b, coarse, values, flag);
         NBVH_CUDA_CHECK(cudaGetLastError());
     }
+    if (coarse == NB_GRID_MAX_LEVELS) return;
+    const uint32_t n = b.n * NB_SEGMENT_POINTS * (NB_GRID_MAX_LEVELS - coarse);
     k_grid_backward<<<(n + 255) / 256, 256, 0, s>>>(net, b, deterministic ? 1 : 0, coarse, flag);
     NBVH_CUDA_CHECK(cudaGetLastError());
 }
