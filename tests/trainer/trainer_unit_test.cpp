@@ -9,6 +9,7 @@
 #include "tests/trainer/trainer_test_scenes.h"
 #include "trainer/cpu/cpu_backend.h"
 #include "trainer/ground_truth.h"
+#include "trainer/model_export.h"
 #include "trainer/texture_sampler.h"
 #include "trainer/trainer.h"
 
@@ -210,4 +211,15 @@ TEST(Trainer, GrowsTheCutToTheTargetAndWritesTheLog) {
     uint32_t lines = 0;
     for (std::string line; std::getline(f, line);) lines++;
     EXPECT_EQ(lines, o.steps);
+
+    // The model file round-trips what was trained.
+    const NeuralModel m = make_neural_model(asset, r, o, "test", 0);
+    const NeuralModel back = parse_model(serialize_model(m));
+    EXPECT_EQ(back.nodes.size(), r.tree.node_count());
+    EXPECT_EQ(back.lod_count, o.lods);
+    EXPECT_EQ(back.mlp.size(), size_t(NB_MLP_WEIGHT_COUNT));
+    EXPECT_EQ(back.grid.size(), r.weights.grid.size());
+    EXPECT_EQ(back.meta.steps, o.steps);
+    EXPECT_EQ(back.meta.backend, "cpu");
+    EXPECT_EQ(back.encoding_box.lo, asset.bounds.lo);
 }
