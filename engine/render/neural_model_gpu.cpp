@@ -48,7 +48,7 @@ std::string coopmat_unavailable_reason(const vk::DeviceFeatures& dev) {
     if (dev.subgroup_size != NB_NEURAL_COOP_SUBGROUP)
         return strfmt("the cooperative-matrix kernel needs subgroups of %u (device: %u)", NB_NEURAL_COOP_SUBGROUP,
                       dev.subgroup_size);
-    if (dev.max_shared_memory < 24u * 1024u) return "the device has less than 24 KiB of shared memory";
+    if (dev.max_shared_memory < 18u * 1024u) return "the device has less than 18 KiB of shared memory";
     if (!has_shape(dev, VK_COMPONENT_TYPE_FLOAT32_NV) && !has_shape(dev, VK_COMPONENT_TYPE_FLOAT16_NV))
         return "the device has no 16x16x16 fp16 cooperative-matrix shape";
     return "";

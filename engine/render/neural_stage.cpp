@@ -87,9 +87,11 @@ void NeuralStage::install(std::vector<vk::Buffer>& buffers) {
     if (buffers.size() < NB_NEURAL_BINDING_END) buffers.resize(NB_NEURAL_BINDING_END);
     model_.move_into(buffers[NB_BIND_NEURAL_LEVELS], buffers[NB_BIND_NEURAL_GRID], buffers[NB_BIND_NEURAL_MLP],
                      buffers[NB_BIND_NBVH_NODES], buffers[NB_BIND_NBVH_BOUNDS]);
-    buffers[NB_BIND_PENDING_LEAVES] = vk::Buffer(ctx_, uint64_t(std::max(capacity_, 1u)) * sizeof(GpuPendingLeaf),
+    // Two halves (ping-pong between a query round and the traversal that follows it).
+    buffers[NB_BIND_PENDING_LEAVES] = vk::Buffer(ctx_, 2ull * std::max(capacity_, 1u) * sizeof(GpuPendingLeaf),
                                                  vk::MemoryKind::device, 0, "pending leaves");
-    buffers[NB_BIND_NEURAL_STATE] = vk::Buffer(ctx_, uint64_t(std::max(capacity_, 1u)) * sizeof(GpuNeuralRayState),
+    // Path rays at [0, capacity), shadow rays at [capacity, 2 capacity).
+    buffers[NB_BIND_NEURAL_STATE] = vk::Buffer(ctx_, 2ull * std::max(capacity_, 1u) * sizeof(GpuNeuralRayState),
                                                vk::MemoryKind::device, 0, "neural ray state");
     buffers[NB_BIND_NEURAL_PARAMS] = vk::make_buffer(ctx_, std::vector<GpuNeuralParams>{params_}, "neural params");
     buffers[NB_BIND_NEURAL_COUNTERS] =

@@ -3,9 +3,12 @@
 // reference (the same instances traced from their triangles with the neural material constants).
 //
 // Per path-ray bounce the renderer records (engine/render/README.md):
-//   neural_traverse(mode 0) -> [neural_args -> neural_query -> neural_traverse(mode 1)] x rounds
-//   -> neural_traverse(mode 2) -> shade
-// instead of traverse; shadow rays query neural leaves inline (scalar path) in passes/shadow.comp.
+//   neural_traverse(op 0, all rays) -> [neural_args -> neural_query -> neural_traverse(op 1, the rays
+//   just queried)] x rounds -> neural_traverse(op 2) -> shade
+// instead of traverse, and for shadow rays
+//   neural_shadow(op 0) -> [neural_args -> neural_query -> neural_shadow(op 1)] x rounds -> shadow
+// The pending queue has two halves: a round's traversal reads its rays from the half just queried and
+// queues into the other (pass constant mode bit 2, shaders/lib/neural_traverse.glsl).
 #pragma once
 #include <cstdint>
 #include <string>

@@ -15,7 +15,7 @@ namespace {
 
 enum Pass : size_t {
     CAMERA, QUEUE_ARGS, TRAVERSE, SHADE, SHADOW, ACCUMULATE, RESOLVE,
-    NEURAL_TRAVERSE, NEURAL_ARGS, NEURAL_QUERY, // hybrid renders only (neural_stage.h)
+    NEURAL_TRAVERSE, NEURAL_ARGS, NEURAL_QUERY, NEURAL_SHADOW, // hybrid renders only (neural_stage.h)
     PASS_COUNT
 };
 // NEURAL_QUERY's shader depends on the MLP path (NeuralStage::query_shader); this entry names its timer.
@@ -23,10 +23,21 @@ const char* const PASS_SHADERS[PASS_COUNT] = {"passes/camera_rays.comp", "passes
                                               "passes/traverse.comp",    "passes/shade.comp",
                                               "passes/shadow.comp",      "passes/accumulate.comp",
                                               "passes/resolve.comp",     "passes/neural_traverse.comp",
-                                              "passes/neural_args.comp", "passes/neural_query.comp"};
+                                              "passes/neural_args.comp", "passes/neural_query.comp",
+                                              "passes/neural_shadow.comp"};
 
 template <class T> vk::Buffer upload(const vk::Context& ctx, const std::vector<T>& items, const char* name) {
     return vk::make_buffer(ctx, items, name);
+}
+
+void set_camera_params(GpuFrameParams& p, const Camera& camera, float aspect) {
+    const CameraBasis basis = camera_basis(camera);
+    p.cam_eye = camera.eye;
+    p.cam_tan_half_fov = std::tan(0.5f * std::clamp(camera.yfov, 1.0e-3f, 3.1f));
+    p.cam_forward = basis.forward;
+    p.aspect = aspect;
+    p.cam_right = basis.right;
+    p.cam_up = basis.up;
 }
 
 } // namespace
@@ -64,15 +75,9 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     if (features_.emission && data_.lights.size() == 1 && data_.light_total_power <= 0.0f) features_.emission = false;
 
     // Per-render parameters.
-    const CameraBasis basis = camera_basis(camera);
     GpuFrameParams& p = params_;
-    p.cam_eye = camera.eye;
-    p.cam_tan_half_fov = std::tan(0.5f * std::clamp(camera.yfov, 1.0e-3f, 3.1f));
-    p.cam_forward = basis.forward;
-    p.aspect = float(options_.width) / float(options_.height);
-    p.cam_right = basis.right;
+    set_camera_params(p, camera, float(options_.width) / float(options_.height));
     p.width = options_.width;
-    p.cam_up = basis.up;
     p.height = options_.height;
     p.env_width = data_.environment.width;
     p.env_height = data_.environment.height;
@@ -131,7 +136,7 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     for (uint32_t b = 0; b < NB_NEURAL_BINDING_END; ++b) bindings.push_back({b, vk::BindingType::storage_buffer, 1});
     const std::vector<vk::SpecConstant> spec = specialization(features_);
     for (size_t i = 0; i < PASS_COUNT; ++i) {
-        if ((i == SHADOW && !features_.has_lights()) || (i >= NEURAL_TRAVERSE && !neural_)) {
+        if (((i == SHADOW || i == NEURAL_SHADOW) && !features_.has_lights()) || (i >= NEURAL_TRAVERSE && !neural_)) {
             pipelines_.emplace_back();
             sets_.emplace_back();
             continue; // no shadow pass without anything to sample
@@ -146,7 +151,7 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
         for (uint32_t b = 0; b < NB_NEURAL_BINDING_END; ++b) set.bind(b, buffers_[b]);
         sets_.push_back(std::move(set));
     }
-    timer_ = vk::GpuTimer(ctx_, 64 + (8 + (neural_ ? 3 * neural_->rounds() + 2 : 0)) * options_.max_depth);
+    timer_ = vk::GpuTimer(ctx_, 64 + (8 + (neural_ ? 6 * neural_->rounds() + 4 : 0)) * options_.max_depth);
     cmd_ = vk::CommandBuffer(ctx_, "wavefront");
 }
 
@@ -183,6 +188,22 @@ void WavefrontRenderer::record_pass(vk::CommandBuffer& cmd, size_t pass, const G
                                                           : vk::Barrier::compute_to_compute);
 }
 
+// Op 0 of `traverse_pass` over every ray (path queue or shadow rays), then per round: hand the queued
+// pairs to the query pass, query them, and resume exactly the rays of those pairs (op 1, dispatched over
+// the pairs). Round r queries pending half r & 1; the traversal after it queues into the other half.
+void WavefrontRenderer::record_neural_rounds(vk::CommandBuffer& cmd, size_t traverse_pass, uint32_t q, uint32_t depth,
+                                             uint32_t sample, uint32_t offset, uint32_t count) {
+    const Dispatch all = traverse_pass == NEURAL_SHADOW ? Dispatch::indirect_shadow : Dispatch::indirect_rays;
+    record_pass(cmd, traverse_pass, constants(q, depth, sample, offset, count, 0), all);
+    for (uint32_t round = 0; round < neural_->rounds(); ++round) {
+        const uint32_t half = round & 1u;
+        record_pass(cmd, NEURAL_ARGS, constants(q, depth, sample, offset, count, 0), Dispatch::single);
+        record_pass(cmd, NEURAL_QUERY, constants(q, depth, sample, offset, count, half << 2), Dispatch::indirect_pending);
+        record_pass(cmd, traverse_pass, constants(q, depth, sample, offset, count, 1u | ((half ^ 1u) << 2)),
+                    Dispatch::indirect_pending);
+    }
+}
+
 void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, uint32_t sample, uint32_t offset, uint32_t count) {
     record_pass(cmd, CAMERA, constants(0, 0, sample, offset, count, 0), Dispatch::items, count);
     uint32_t q = 0;
@@ -190,12 +211,7 @@ void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, uint32_t samp
         record_pass(cmd, QUEUE_ARGS, constants(q, depth, sample, offset, count, NB_ARGS_MODE_RAYS), Dispatch::single);
         if (neural_) {
             // Closest hits through triangles and neural leaves: queue a pair per ray, query, resume.
-            record_pass(cmd, NEURAL_TRAVERSE, constants(q, depth, sample, offset, count, 0), Dispatch::indirect_rays);
-            for (uint32_t round = 0; round < neural_->rounds(); ++round) {
-                record_pass(cmd, NEURAL_ARGS, constants(q, depth, sample, offset, count, 0), Dispatch::single);
-                record_pass(cmd, NEURAL_QUERY, constants(q, depth, sample, offset, count, 0), Dispatch::indirect_pending);
-                record_pass(cmd, NEURAL_TRAVERSE, constants(q, depth, sample, offset, count, 1), Dispatch::indirect_rays);
-            }
+            record_neural_rounds(cmd, NEURAL_TRAVERSE, q, depth, sample, offset, count);
             record_pass(cmd, NEURAL_TRAVERSE, constants(q, depth, sample, offset, count, 2), Dispatch::indirect_rays);
         } else {
             record_pass(cmd, TRAVERSE, constants(q, depth, sample, offset, count, 0), Dispatch::indirect_rays);
@@ -204,6 +220,7 @@ void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, uint32_t samp
         if (features_.has_lights()) {
             record_pass(cmd, QUEUE_ARGS, constants(q, depth, sample, offset, count, NB_ARGS_MODE_SHADOW),
                         Dispatch::single);
+            if (neural_) record_neural_rounds(cmd, NEURAL_SHADOW, q, depth, sample, offset, count);
             record_pass(cmd, SHADOW, constants(q, depth, sample, offset, count, 0), Dispatch::indirect_shadow);
         }
         q = 1 - q;
@@ -212,9 +229,27 @@ void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, uint32_t samp
 }
 
 RenderResult WavefrontRenderer::render() {
+    RenderResult result = render_samples(0, options_.spp);
+    accumulated_ = options_.spp;
+    return result;
+}
+
+void WavefrontRenderer::set_camera(const Camera& camera) {
+    set_camera_params(params_, camera, float(options_.width) / float(options_.height));
+    buffers_[NB_BIND_PARAMS].upload(&params_, sizeof(params_));
+    accumulated_ = 0;
+}
+
+RenderResult WavefrontRenderer::render_progressive(uint32_t samples) {
+    RenderResult result = render_samples(accumulated_, samples);
+    accumulated_ += samples;
+    return result;
+}
+
+RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_samples) {
     const auto t0 = std::chrono::steady_clock::now();
     const uint32_t pixels = options_.width * options_.height;
-    buffers_[NB_BIND_FILM].fill(0u);
+    if (first == 0) buffers_[NB_BIND_FILM].fill(0u);
     buffers_[NB_BIND_COUNTERS].fill(0u);
     if (neural_) buffers_[NB_BIND_NEURAL_COUNTERS].fill(0u);
 
@@ -233,7 +268,7 @@ RenderResult WavefrontRenderer::render() {
         }
     };
     // One submission per (sample, wave): bounded command buffers and timer slots at any spp.
-    for (uint32_t sample = 0; sample < options_.spp; ++sample) {
+    for (uint32_t sample = first; sample < first + count_samples; ++sample) {
         for (uint32_t offset = 0; offset < pixels; offset += capacity_) {
             const uint32_t count = std::min(capacity_, pixels - offset);
             cmd_.begin();
@@ -260,7 +295,7 @@ RenderResult WavefrontRenderer::render() {
     s.driver = ctx_.features().driver_name + " " + ctx_.features().driver_info;
     s.width = options_.width;
     s.height = options_.height;
-    s.spp = options_.spp;
+    s.spp = first + count_samples;
     s.max_depth = options_.max_depth;
     s.pass_ms = pass_ms;
     for (const auto& [name, ms] : pass_ms) s.gpu_ms += ms;

@@ -84,6 +84,13 @@ public:
     // Renders options.spp samples per pixel and reads the mean radiance back.
     RenderResult render();
 
+    // Progressive rendering (the interactive viewer, app/viewer/): `set_camera` changes the view of
+    // later samples and clears the film; `render_progressive` adds `samples` samples per pixel to the
+    // film and reads back the running mean (stats: rays and times of this call; spp = samples so far).
+    void set_camera(const Camera& camera);
+    RenderResult render_progressive(uint32_t samples = 1);
+    uint32_t accumulated_samples() const { return accumulated_; }
+
     // Closest hits of world-space rays (org, dir; t in [tmin, inf)) through passes/traverse.comp.
     std::vector<TraceHit> trace(const std::vector<glm::vec3>& origins, const std::vector<glm::vec3>& dirs, float tmin = 0.0f);
 
@@ -94,6 +101,10 @@ private:
     void record_pass(vk::CommandBuffer& cmd, size_t pass, const GpuPassConstants& pc, Dispatch dispatch,
                      uint64_t items = 0);
     void record_sample_wave(vk::CommandBuffer& cmd, uint32_t sample, uint32_t offset, uint32_t count);
+    void record_neural_rounds(vk::CommandBuffer& cmd, size_t traverse_pass, uint32_t q, uint32_t depth, uint32_t sample,
+                              uint32_t offset, uint32_t count);
+    // Samples [first, first + count) into the film (cleared when first == 0), then resolve + read back.
+    RenderResult render_samples(uint32_t first, uint32_t count);
 
     const vk::Context& ctx_;
     RenderOptions options_;
@@ -101,6 +112,7 @@ private:
     GpuSceneData data_;
     GpuFrameParams params_{};
     uint32_t capacity_ = 0;
+    uint32_t accumulated_ = 0; // samples per pixel in the film (progressive rendering)
 
     std::vector<vk::Buffer> buffers_;          // indexed by NB_BIND_*
     std::vector<vk::ComputePipeline> pipelines_; // indexed by Pass

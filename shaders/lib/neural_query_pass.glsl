@@ -13,6 +13,8 @@ struct NbPendingQuery {
     vec3 dir;
 };
 
+// Pair k of pending half nb_nl_half(pc.mode) (neural_traverse.glsl). Rays >= capacity are shadow
+// rays (shadow SOA index ray - capacity), the others path rays of queue pc.in_queue.
 NbPendingQuery nb_load_pending(uint k) {
     NbPendingQuery r;
     r.valid = k < neural_counters.pending_active;
@@ -24,10 +26,14 @@ NbPendingQuery nb_load_pending(uint k) {
     r.pl.t_enter = 0.0f;
     r.pl.t_exit = 0.0f;
     if (!r.valid) return r;
-    r.pl = pending_leaves[k];
+    uint cap = ray_capacity();
+    r.pl = pending_leaves[((pc.mode >> 2u) & 1u) * cap + k];
     GpuInstance inst = instances[r.pl.instance];
-    r.org = nb_xform_point(inst.world_to_object, ray_load3(pc.in_queue, NB_RAY_ORIGIN, r.pl.ray));
-    r.dir = nb_xform_vector(inst.world_to_object, ray_load3(pc.in_queue, NB_RAY_DIR, r.pl.ray));
+    bool shadow = r.pl.ray >= cap;
+    vec3 o = shadow ? shadow_load3(NB_SHADOW_ORIGIN, r.pl.ray - cap) : ray_load3(pc.in_queue, NB_RAY_ORIGIN, r.pl.ray);
+    vec3 d = shadow ? shadow_load3(NB_SHADOW_DIR, r.pl.ray - cap) : ray_load3(pc.in_queue, NB_RAY_DIR, r.pl.ray);
+    r.org = nb_xform_point(inst.world_to_object, o);
+    r.dir = nb_xform_vector(inst.world_to_object, d);
     return r;
 }
 
@@ -35,9 +41,12 @@ void nb_apply_neural_result(NbPendingQuery r, float y[NB_MLP_OUTPUTS]) {
     GpuNeuralHit h = nb_neural_decode(neural_params.box, y, r.pl.t_enter, r.pl.t_exit, neural_params.threshold);
     uint ray = r.pl.ray;
     GpuNeuralRayState st = neural_state[ray];
-    float tmin = uintBitsToFloat(ray_load1(pc.in_queue, NB_RAY_T_RESUME, ray));
+    uint cap = ray_capacity();
+    bool shadow = ray >= cap;
+    float tmin = shadow ? 0.0f : uintBitsToFloat(ray_load1(pc.in_queue, NB_RAY_T_RESUME, ray));
+    float tmax = shadow ? uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, ray - cap)) : NB_INF;
     if ((h.flags & (NB_NEURAL_VISIBLE | NB_NEURAL_ACCEPTED)) == (NB_NEURAL_VISIBLE | NB_NEURAL_ACCEPTED) &&
-        h.t > tmin && h.t < st.best_t) {
+        h.t > tmin && h.t < tmax && h.t < st.best_t) {
         st.best_t = h.t;
         vec3 n = nb_xform_normal(instances[r.pl.instance].world_to_object, h.normal);
         float len = length(n);

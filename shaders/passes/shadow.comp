@@ -14,8 +14,15 @@ void main() {
     float tmax = uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, i));
     uint pixel = shadow_load1(NB_SHADOW_PIXEL, i);
     g_alpha_seed = nb_pcg_hash(pixel ^ (pc.depth << 24u) ^ pc.sample_index);
-    nb_trace(org, dir, 0.0f, tmax, true);
-    if (g_hit_instance == NB_NO_HIT) {
+    bool occluded;
+    if (NB_HAS_NEURAL) {
+        // Hybrid render: passes/neural_shadow.comp decided (triangles and neural leaves).
+        occluded = neural_state[ray_capacity() + i].best_t < NB_INF;
+    } else {
+        nb_trace(org, dir, 0.0f, tmax, true);
+        occluded = g_hit_instance != NB_NO_HIT;
+    }
+    if (!occluded) {
         // At most one shadow ray per path per bounce and one path per pixel per wave: no write races.
         sample_radiance[pixel - pc.pixel_offset] += shadow_load3(NB_SHADOW_CONTRIB, i);
     }

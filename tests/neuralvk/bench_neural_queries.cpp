@@ -1,6 +1,7 @@
 // Benchmark of the neural query kernels (issue 4, not a test): neural queries per second of the scalar
 // and the cooperative-matrix path on the same random queries, and how far the two paths agree.
 //   nbvh_bench_neural [--model M.nbvh] [--queries N] [--reps R] [--device auto|gpu|cpu] [--json out.json]
+//                     [--coherent]   (camera-ray ordered queries instead of random ones)
 // Without --model a random network with varied outputs (tests/neuralvk/neural_test_model.h, hash 2^18,
 // the paper's size) is used: the kernels' cost does not depend on the weights' values.
 // Queries: random rays through random leaf-sized boxes of the asset, a quarter starting inside.
@@ -42,12 +43,45 @@ std::vector<GpuNeuralQuery> make_queries(size_t n, glm::vec3 lo, glm::vec3 hi, u
     return out;
 }
 
+// Coherent queries, as camera rays produce them: a pinhole camera looking at the asset, one ray per
+// pixel of a square image in row order, each against the cell of a 16^3 grid over the asset box
+// (leaf-sized) that contains its entry point.
+std::vector<GpuNeuralQuery> make_coherent_queries(size_t n, glm::vec3 lo, glm::vec3 hi) {
+    const uint32_t side = uint32_t(std::sqrt(double(n)));
+    const glm::vec3 c = 0.5f * (lo + hi), ext = hi - lo;
+    const float diag = glm::length(ext);
+    const glm::vec3 eye = c + glm::normalize(glm::vec3(0.3f, 0.4f, 1.0f)) * (1.5f * diag);
+    const glm::vec3 fwd = glm::normalize(c - eye);
+    const glm::vec3 right = glm::normalize(glm::cross(fwd, glm::vec3(0, 1, 0)));
+    const glm::vec3 up = glm::cross(right, fwd);
+    std::vector<GpuNeuralQuery> out;
+    out.reserve(size_t(side) * side);
+    const glm::vec3 cell = ext / 16.0f;
+    for (uint32_t y = 0; y < side; ++y)
+        for (uint32_t x = 0; x < side; ++x) {
+            const float u = (x + 0.5f) / side * 2 - 1, v = (y + 0.5f) / side * 2 - 1;
+            const glm::vec3 d = glm::normalize(fwd + 0.35f * (u * right + v * up));
+            const glm::vec3 inv = nb_safe_inv_dir(d);
+            float t0, t1;
+            if (!nb_intersect_aabb_interval(eye, inv, lo, hi, -NB_INF, NB_INF, t0, t1)) continue;
+            const glm::vec3 p = eye + d * (t0 + 1e-4f * diag);
+            const glm::vec3 k = glm::clamp(glm::floor((p - lo) / cell), glm::vec3(0), glm::vec3(15));
+            GpuNeuralQuery q;
+            q.origin = eye;
+            q.dir = d;
+            if (!nb_neural_leaf_interval(eye, inv, lo + k * cell, lo + (k + 1.0f) * cell, q.t_entry, q.t_exit)) continue;
+            out.push_back(q);
+        }
+    return out;
+}
+
 } // namespace
 
 int main(int argc, char** argv) try {
     std::string model_path, json_path, device = "auto";
     size_t n = size_t(1) << 22;
     int reps = 10;
+    bool coherent = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
@@ -59,6 +93,7 @@ int main(int argc, char** argv) try {
         else if (a == "--reps") reps = std::stoi(next());
         else if (a == "--device") device = next();
         else if (a == "--json") json_path = next();
+        else if (a == "--coherent") coherent = true;
         else throw Error("unknown option " + a);
     }
     vk::ContextOptions o;
@@ -73,7 +108,9 @@ int main(int argc, char** argv) try {
     if (!model_path.empty()) model = load_model(model_path);
     NeuralModelGpu gpu(ctx, model);
     const std::vector<GpuNeuralQuery> qs =
-        make_queries(n, model.encoding_box.lo, model.encoding_box.hi, 1234);
+        coherent ? make_coherent_queries(n, model.encoding_box.lo, model.encoding_box.hi)
+                 : make_queries(n, model.encoding_box.lo, model.encoding_box.hi, 1234);
+    std::printf("%zu %s queries\n", qs.size(), coherent ? "coherent (camera-ray order)" : "random incoherent");
 
     struct Row { std::string path; double ms = 0; double qps = 0; std::vector<GpuNeuralHit> hits; };
     std::vector<Row> rows;
@@ -122,7 +159,7 @@ int main(int argc, char** argv) try {
     if (!json_path.empty()) {
         std::ofstream f(json_path);
         f << "{\n  \"device\": \"" << dev.device_name << "\",\n  \"driver\": \"" << dev.driver_name << " "
-          << dev.driver_info << "\",\n  \"queries\": " << qs.size() << ",\n  \"reps\": " << reps
+          << dev.driver_info << "\",\n  \"queries\": " << qs.size() << ",\n  \"query_order\": \"" << (coherent ? "coherent" : "random") << "\",\n  \"reps\": " << reps
           << ",\n  \"model\": \"" << (model_path.empty() ? "random (hash 2^18)" : model_path) << "\",\n  \"paths\": [";
         for (size_t i = 0; i < rows.size(); ++i)
             f << (i ? ", " : "") << "{\"path\": \"" << rows[i].path << "\", \"ms\": " << rows[i].ms

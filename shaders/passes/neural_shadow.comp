@@ -1,0 +1,50 @@
+// Neural visibility of shadow rays (hybrid renders), before passes/shadow.comp: the same ordered leaf
+// search and batched queries as path rays (passes/neural_traverse.comp), with any-hit semantics. The
+// state of shadow ray i lives at neural_state[capacity + i]; its best_t < NB_INF means "occluded".
+//   op 0: every shadow ray: triangle any-hit (occluded -> done), else queue the first neural leaf;
+//   op 1: the rays of the pairs just queried: occluded -> done, else queue the next leaf.
+// shadow.comp then reads the result instead of tracing.
+#version 460
+#include "lib/bindings.glsl"
+#include "lib/traverse.glsl"
+
+layout(local_size_x = NB_WAVEFRONT_GROUP) in;
+
+void main() {
+    uint op = nb_nl_op(pc.mode);
+    uint half_ = nb_nl_half(pc.mode);
+    uint cap = ray_capacity();
+    uint i;
+    GpuNeuralRayState st;
+    if (op == 1u) {
+        uint k = gl_GlobalInvocationID.x;
+        if (k >= neural_counters.pending_active) return;
+        i = pending_leaves[(half_ ^ 1u) * cap + k].ray - cap;
+        st = neural_state[cap + i];
+        if (st.status != NB_NRAY_TRACE) return;
+        if (st.best_t < NB_INF) { // the query found an occluder
+            st.status = NB_NRAY_DONE;
+            neural_state[cap + i] = st;
+            return;
+        }
+    } else {
+        i = gl_GlobalInvocationID.x;
+        if (i >= counters.shadow_count) return;
+        st = nb_nl_fresh_state();
+    }
+    vec3 org = shadow_load3(NB_SHADOW_ORIGIN, i);
+    vec3 dir = shadow_load3(NB_SHADOW_DIR, i);
+    float tmax = uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, i));
+    uint pixel = shadow_load1(NB_SHADOW_PIXEL, i);
+    g_alpha_seed = nb_pcg_hash(pixel ^ (pc.depth << 24u) ^ pc.sample_index);
+    nb_nl_begin(st, neural_params.root_secondary);
+    g_nl_skip_triangles = op != 0u;
+    nb_trace(org, dir, 0.0f, tmax, true);
+    if (op == 0u && g_hit_instance != NB_NO_HIT) {
+        st.best_t = g_tmax; // a triangle occludes
+        st.status = NB_NRAY_DONE;
+    } else if (!nb_nl_queue_candidate(cap + i, half_, tmax, st)) {
+        st.status = NB_NRAY_DONE;
+    }
+    neural_state[cap + i] = st;
+}
