@@ -1,12 +1,38 @@
-// nbvh view — being written (scaffold from the project skeleton; replaced by its issue's work).
+// nbvh view SCENE [--model M.nbvh] [--env FILE] [--width W --height H] [--device auto|gpu|cpu]
+//                 [--max-depth D] [--lod L] [--secondary-lod L] [--neural GLOB]
+//                 [--screenshot FILE.png] [--frames N] [--hide-ui]
+// The interactive viewer (app/viewer/): progressive path tracing in a window with a UI panel.
+// --frames N exits after N frames (headless tests under Xvfb); --screenshot saves the window then.
+#include <memory>
+
 #include "app/commands.h"
-#include "engine/core/error.h"
+#include "app/viewer/viewer.h"
 
 namespace nbvh::app {
 
 void add_view_command(CLI::App& app) {
-    auto* cmd = app.add_subcommand("view", "(not built yet)");
-    cmd->callback([] { throw Error("'nbvh view' is not built yet"); });
+    auto args = std::make_shared<viewer::ViewerArgs>();
+    auto* cmd = app.add_subcommand("view", "interactive viewer: progressive path tracing, LoD and node-count sliders");
+    cmd->add_option("scene", args->scene, "glTF/GLB file, or 'default' for the built-in scene")->required();
+    cmd->add_option("--model", args->model, "N-BVH model (.nbvh) for the scene's neural instances");
+    cmd->add_option("--env", args->env, "environment map (.hdr or .exr, equirectangular)");
+    cmd->add_option("--neural", args->neural_glob, "nodes whose name matches this glob are neural instances");
+    cmd->add_option("--width", args->width, "window width in pixels")->check(CLI::Range(16u, 16384u));
+    cmd->add_option("--height", args->height, "window height in pixels")->check(CLI::Range(16u, 16384u));
+    cmd->add_option("--device", args->device, "Vulkan device: auto, gpu or cpu (lavapipe)");
+    cmd->add_option("--max-depth", args->max_depth, "maximum path segments")->check(CLI::Range(1u, 256u));
+    cmd->add_option("--lod", args->lod, "initial N-BVH level of detail (0 = finest)");
+    cmd->add_option("--secondary-lod", args->secondary_lod, "initial LoD after the first hit (-1: same as --lod)")
+        ->check(CLI::Range(-1, 1 << 20));
+    cmd->add_option("--screenshot", args->screenshot, "save the window content as PNG after --frames frames");
+    cmd->add_option("--frames", args->frames, "exit after this many frames (default with --screenshot: 16)")
+        ->check(CLI::Range(1u, 1u << 20));
+    cmd->add_flag("--hide-ui", args->hide_ui, "start with the UI panel hidden (F1 toggles it)");
+    cmd->callback([args] {
+        viewer::ViewerArgs a = *args;
+        if (!a.screenshot.empty() && a.frames == 0) a.frames = 16;
+        viewer::run_viewer(a);
+    });
 }
 
 } // namespace nbvh::app

@@ -33,3 +33,14 @@ if(NBVH_BUILD_TESTS)  # (included from the top level so imported targets are glo
   find_package(GTest REQUIRED)
   find_package(benchmark QUIET)
 endif()
+
+# GLFW + Dear ImGui (the interactive viewer, app/viewer/). Debian's libimgui-dev ships a static
+# libimgui.a with the GLFW and Vulkan backends compiled in and headers under /usr/include/imgui
+# (backends/ beside them); it needs libstb (stb_truetype) and GLFW at link time.
+find_package(glfw3 3.3 REQUIRED)
+find_library(NBVH_IMGUI_LIBRARY imgui REQUIRED)
+find_path(NBVH_IMGUI_INCLUDE_DIR imgui.h PATHS /usr/include/imgui REQUIRED)
+add_library(nbvh_imgui INTERFACE)
+add_library(nbvh::imgui ALIAS nbvh_imgui)
+target_include_directories(nbvh_imgui INTERFACE ${NBVH_IMGUI_INCLUDE_DIR} ${NBVH_IMGUI_INCLUDE_DIR}/backends)
+target_link_libraries(nbvh_imgui INTERFACE ${NBVH_IMGUI_LIBRARY} glfw nbvh::stb Vulkan::Vulkan)

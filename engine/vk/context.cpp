@@ -100,9 +100,9 @@ static bool env_flag(const char* name, bool fallback) {
 
 Context::Context(const ContextOptions& options) : debug_(std::make_unique<Debug>()) {
     try {
-        create_instance(env_flag("NBVH_VALIDATION", options.validation));
+        create_instance(env_flag("NBVH_VALIDATION", options.validation), options.instance_extensions);
         pick_physical_device(options.device);
-        create_device();
+        create_device(options.device_extensions);
     } catch (...) {
         destroy();
         throw;
@@ -145,7 +145,7 @@ void Context::destroy() {
     instance_ = VK_NULL_HANDLE;
 }
 
-void Context::create_instance(bool validation) {
+void Context::create_instance(bool validation, const std::vector<std::string>& extra_extensions) {
     uint32_t loader_version = VK_API_VERSION_1_0;
     if (vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS || loader_version < VK_API_VERSION_1_2)
         throw Error("the Vulkan loader is older than Vulkan 1.2; install a newer libvulkan1");
@@ -174,6 +174,11 @@ void Context::create_instance(bool validation) {
 
     std::vector<const char*> enabled_exts;
     if (have_debug_utils) enabled_exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    for (const std::string& name : extra_extensions) {
+        if (!std::any_of(exts.begin(), exts.end(), [&](const VkExtensionProperties& e) { return name == e.extensionName; }))
+            throw Error(strfmt("the Vulkan loader lacks the instance extension %s", name.c_str()));
+        enabled_exts.push_back(name.c_str());
+    }
 
     VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
     app.pApplicationName = "nbvh";

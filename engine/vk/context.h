@@ -49,6 +49,10 @@ struct ContextOptions {
 #else
     bool validation = true;
 #endif
+    // Extra extensions the caller needs (the viewer: the window system's surface extensions and
+    // VK_KHR_swapchain). One the driver lacks is a user error (nbvh::Error naming it).
+    std::vector<std::string> instance_extensions;
+    std::vector<std::string> device_extensions;
 };
 
 // One supported VK_NV_cooperative_matrix configuration (D = A*B + C, A is MxK, B is KxN).
@@ -141,9 +145,9 @@ public:
 private:
     struct Debug; // heap-held so the messenger's user pointer survives moves
     void destroy();
-    void create_instance(bool validation);
+    void create_instance(bool validation, const std::vector<std::string>& extra_extensions);
     void pick_physical_device(DeviceChoice choice);
-    void create_device();
+    void create_device(const std::vector<std::string>& extra_extensions);
 
     std::unique_ptr<Debug> debug_;
     VkInstance instance_ = VK_NULL_HANDLE;

@@ -136,7 +136,7 @@ void Context::pick_physical_device(DeviceChoice choice) {
     }
 }
 
-void Context::create_device() {
+void Context::create_device(const std::vector<std::string>& extra_extensions) {
     const std::vector<VkExtensionProperties> exts = device_extensions(physical_);
     const bool has_ssc = has_extension(exts, VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME);
     const bool has_coop = has_extension(exts, VK_NV_COOPERATIVE_MATRIX_EXTENSION_NAME);
@@ -251,6 +251,11 @@ void Context::create_device() {
         enabled.push_back(VK_NV_COOPERATIVE_MATRIX_EXTENSION_NAME);
     }
     if (has_nsi) enabled.push_back(VK_KHR_SHADER_NON_SEMANTIC_INFO_EXTENSION_NAME); // debugPrintf
+    for (const std::string& name : extra_extensions) {
+        if (!has_extension(exts, name.c_str()))
+            throw Error(strfmt("the Vulkan device %s lacks the extension %s", d.device_name.c_str(), name.c_str()));
+        enabled.push_back(name.c_str());
+    }
 
     float priority = 1.0f;
     VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};

@@ -1,0 +1,102 @@
+// The viewer's window and swapchain: a GLFW window without a client API, its Vulkan surface, a
+// swapchain, and the per-frame commands that put the film on screen:
+//   film (RGBA8, sRGB-encoded by the host tone map) -> staging buffer -> film image
+//   -> clear + aspect-preserving blit into the swapchain image -> render pass (UI drawn on top,
+//   loadOp LOAD) -> [copy to a readback buffer for --screenshot] -> present.
+// One frame in flight: the path tracer waits for its own submissions anyway, so more would buy
+// nothing but complexity. Presentation needs the Context's queue family to support the surface.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "engine/vk/buffer.h"
+#include "engine/vk/context.h"
+
+struct GLFWwindow;
+
+namespace nbvh::viewer {
+
+// glfwInit + a window. Throws nbvh::Error "no display available (set DISPLAY or use nbvh render)"
+// without a display, and a clear line when GLFW has no Vulkan loader.
+class Window {
+public:
+    Window(int width, int height, const std::string& title);
+    ~Window();
+    Window(const Window&) = delete;
+    Window& operator=(const Window&) = delete;
+
+    GLFWwindow* handle() const { return window_; }
+    // Instance extensions the surface needs (VK_KHR_surface + the platform's).
+    static std::vector<std::string> required_instance_extensions();
+    bool should_close() const;
+    void request_close();
+    void set_title(const std::string& title);
+    void framebuffer_size(uint32_t* width, uint32_t* height) const;
+
+private:
+    GLFWwindow* window_ = nullptr;
+};
+
+// 8-bit RGB pixels read back from the window (for --screenshot), rows top to bottom.
+struct Screenshot {
+    uint32_t width = 0, height = 0;
+    std::vector<uint8_t> rgb;
+};
+
+class Presenter {
+public:
+    Presenter(const vk::Context& ctx, const Window& window);
+    ~Presenter();
+    Presenter(const Presenter&) = delete;
+    Presenter& operator=(const Presenter&) = delete;
+
+    VkRenderPass render_pass() const { return render_pass_; }
+    uint32_t min_image_count() const { return min_image_count_; }
+    uint32_t image_count() const { return uint32_t(images_.size()); }
+    VkFormat format() const { return format_.format; }
+    bool can_read_back() const { return can_read_back_; }
+
+    // Draws one frame: `rgba` is width*height sRGB-encoded RGBA8 pixels (rows top to bottom), `ui`
+    // records draw commands inside the render pass. Fills `shot` (when not null and can_read_back())
+    // with the window content. Returns false when nothing was presented (minimised window, or the
+    // swapchain was out of date and has been recreated).
+    bool draw(const uint8_t* rgba, uint32_t width, uint32_t height, const std::function<void(VkCommandBuffer)>& ui,
+              Screenshot* shot = nullptr);
+
+private:
+    void create_swapchain();
+    void destroy_swapchain();
+    void ensure_film_image(uint32_t width, uint32_t height);
+    void destroy_film_image();
+
+    const vk::Context& ctx_;
+    const Window& window_;
+    VkSurfaceKHR surface_ = VK_NULL_HANDLE;
+    VkSurfaceFormatKHR format_{};
+    VkRenderPass render_pass_ = VK_NULL_HANDLE;
+    VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
+    VkExtent2D extent_{};
+    uint32_t min_image_count_ = 2;
+    bool can_read_back_ = false;
+    std::vector<VkImage> images_;
+    std::vector<VkImageView> views_;
+    std::vector<VkFramebuffer> framebuffers_;
+    std::vector<VkSemaphore> render_done_; // one per swapchain image (presentation holds it)
+
+    VkImage film_image_ = VK_NULL_HANDLE;
+    VkDeviceMemory film_memory_ = VK_NULL_HANDLE;
+    uint32_t film_width_ = 0, film_height_ = 0;
+    vk::Buffer staging_;  // host-visible RGBA8 film
+    vk::Buffer readback_; // host-visible swapchain copy (screenshots)
+
+    VkCommandPool pool_ = VK_NULL_HANDLE;
+    VkCommandBuffer cmd_ = VK_NULL_HANDLE;
+    VkSemaphore acquired_ = VK_NULL_HANDLE;
+    VkFence fence_ = VK_NULL_HANDLE;
+};
+
+} // namespace nbvh::viewer

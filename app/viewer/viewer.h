@@ -1,0 +1,29 @@
+// nbvh view: the interactive viewer (window + swapchain + Dear ImGui over the wavefront path
+// tracer, accumulating samples progressively; app/README.md). The viewer owns UI state; the
+// renderer is rebuilt when a setting it bakes in changes and told the camera otherwise.
+#pragma once
+#include <cstdint>
+#include <string>
+
+namespace nbvh::viewer {
+
+struct ViewerArgs {
+    std::string scene;            // glTF/GLB file or "default"
+    std::string model;            // .nbvh for the scene's neural instances (hybrid render)
+    std::string env;              // environment map override
+    std::string neural_glob;      // nodes whose name matches are neural instances
+    std::string device = "auto";  // auto | gpu | cpu
+    uint32_t width = 1280, height = 720; // window (and initial film) size
+    uint32_t max_depth = 8;
+    uint32_t lod = 0;
+    int32_t secondary_lod = -1;
+    std::string screenshot;       // PNG of the window content after `frames` frames
+    uint32_t frames = 0;          // > 0: exit after this many frames (headless tests)
+    bool hide_ui = false;
+};
+
+// Runs until the window is closed (or `frames` frames). Throws nbvh::Error on user errors (no
+// display, bad scene/model), and when Vulkan validation is on and reported anything.
+void run_viewer(const ViewerArgs& args);
+
+} // namespace nbvh::viewer
