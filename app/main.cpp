@@ -1,6 +1,7 @@
 // nbvh: neural BVH renderer. Subcommands: render, train, flip, info, bench, view.
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -19,7 +20,14 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        // --help/--version (exit code 0) print as CLI11 does; a usage error is one line like every other
+        // error (CLI11's default adds a second "Run with --help" line).
+        if (e.get_exit_code() == 0) return app.exit(e);
+        std::string msg = e.what();
+        for (char& c : msg)
+            if (c == '\n') c = ' ';
+        std::fprintf(stderr, "nbvh: error: %s (see nbvh --help)\n", msg.c_str());
+        return e.get_exit_code();
     } catch (const nbvh::Error& e) {
         std::fprintf(stderr, "nbvh: error: %s\n", e.what());
         return 1;
