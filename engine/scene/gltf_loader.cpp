@@ -39,13 +39,20 @@ bool is_neural_scene_name(const std::string& name) {
 
 tinygltf::Model parse_file(const std::filesystem::path& path, bool keep_textures) {
     const std::string file = path.string();
+    // A directory opens as an ifstream on Linux and tinygltf then sizes its read buffer from it (a huge
+    // allocation), so refuse anything that is not a regular file up front; likewise other formats.
+    std::error_code fs_ec;
+    if (std::filesystem::is_directory(path, fs_ec))
+        throw Error(strfmt("'%s' is a directory, not a scene file (.gltf or .glb)", file.c_str()));
+    std::string ext = path.extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".gltf" && ext != ".glb")
+        throw Error(strfmt("%s: unsupported scene format '%s' (expected .gltf or .glb)", file.c_str(), ext.c_str()));
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(strfmt("cannot open scene file '%s'", file.c_str()));
     char magic[4] = {0, 0, 0, 0};
     in.read(magic, 4);
     const bool binary = in.gcount() == 4 && std::string(magic, 4) == "glTF";
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
     if (ext == ".glb" && !binary) {
         std::string shown;
         for (int i = 0; i < int(in.gcount()); ++i)
