@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include <unistd.h>
+
 // Debian's libstb (and libtinyexr) ship the implementations compiled: include the headers only,
 // never define STB_IMAGE_IMPLEMENTATION / TINYEXR_IMPLEMENTATION here.
 #include <stb_image.h>
@@ -25,6 +27,26 @@ std::string lower_extension(const std::string& path) {
     std::string ext = std::filesystem::path(path).extension().string();
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
     return ext;
+}
+
+// Writes through `write(tmp)` into a temporary file beside `path`, then renames it into place, so a
+// failed or interrupted write never leaves a truncated image where the user's file was (rename within
+// one directory is atomic on POSIX). The temporary keeps the extension-free suffix ".tmp<pid>".
+template <class WriteFn>
+void write_atomically(const std::string& path, const char* kind, WriteFn&& write) {
+    const std::string tmp = path + strfmt(".tmp%ld", long(::getpid()));
+    std::error_code ec;
+    try {
+        write(tmp);
+    } catch (...) {
+        std::filesystem::remove(tmp, ec);
+        throw;
+    }
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) {
+        std::filesystem::remove(tmp, ec);
+        throw Error(strfmt("cannot write %s '%s': %s", kind, path.c_str(), ec.message().c_str()));
+    }
 }
 
 void check_size(const std::string& path, int w, int h) {
@@ -178,8 +200,10 @@ std::vector<uint8_t> to_srgb8(const Image& img, const PngEncode& enc, int* out_c
 
 void save_png_8bit(const std::string& path, int width, int height, int channels, const uint8_t* pixels) {
     NBVH_CHECK(width > 0 && height > 0 && channels >= 1 && channels <= 4);
-    if (!stbi_write_png(path.c_str(), width, height, channels, pixels, width * channels))
-        throw Error(strfmt("cannot write PNG '%s'", path.c_str()));
+    write_atomically(path, "PNG", [&](const std::string& tmp) {
+        if (!stbi_write_png(tmp.c_str(), width, height, channels, pixels, width * channels))
+            throw Error(strfmt("cannot write PNG '%s' (does its directory exist and is it writable?)", path.c_str()));
+    });
 }
 
 void save_png(const std::string& path, const Image& img, const PngEncode& enc) {
@@ -192,13 +216,17 @@ void save_png(const std::string& path, const Image& img, const PngEncode& enc) {
 void save_exr(const std::string& path, const Image& img, bool half) {
     if (img.empty()) throw Error(strfmt("cannot write EXR '%s': empty image", path.c_str()));
     NBVH_CHECK(img.channels == 1 || img.channels == 3 || img.channels == 4);
-    const char* err = nullptr;
-    const int rc = SaveEXR(img.data.data(), img.width, img.height, img.channels, half ? 1 : 0, path.c_str(), &err);
-    if (rc != TINYEXR_SUCCESS) {
-        const std::string msg = err ? err : "unknown error";
-        if (err) FreeEXRErrorMessage(err);
-        throw Error(strfmt("cannot write EXR '%s': %s", path.c_str(), msg.c_str()));
-    }
+    write_atomically(path, "EXR", [&](const std::string& tmp) {
+        const char* err = nullptr;
+        const int rc = SaveEXR(img.data.data(), img.width, img.height, img.channels, half ? 1 : 0, tmp.c_str(), &err);
+        if (rc != TINYEXR_SUCCESS) {
+            std::string msg = err ? err : "unknown error";
+            if (err) FreeEXRErrorMessage(err);
+            for (char& c : msg)
+                if (c == '\n') c = ' ';
+            throw Error(strfmt("cannot write EXR '%s': %s", path.c_str(), msg.c_str()));
+        }
+    });
 }
 
 size_t count_non_finite(const Image& img) {
