@@ -9,13 +9,14 @@
 // (PNG: ACES-fit tone map + sRGB, engine/core/image.h; EXR: linear radiance).
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/output_path.h"
 #include "app/scene_arg.h"
 #include "engine/bvh/scene_accel.h"
 #include "engine/core/error.h"
@@ -79,14 +80,18 @@ void write_stats(const std::string& path, const render::RenderStats& s, const st
         n["queries_per_second"] = s.neural_queries_per_second();
         j["neural"] = n;
     }
-    std::ofstream f(path);
-    if (!f) throw Error(strfmt("cannot write stats file '%s'", path.c_str()));
-    f << j.dump(2) << "\n";
+    write_text_atomically(path, j.dump(2) + "\n");
 }
 
 void run_render(const RenderArgs& a) {
     if (!is_png_path(a.out) && !is_exr_path(a.out))
         throw Error(strfmt("--out '%s': expected a .png or .exr file name", a.out.c_str()));
+    // Everything that can be checked cheaply is checked before the scene is loaded and rendered.
+    const std::vector<std::string> inputs = {a.scene, a.env, a.model};
+    check_output_path(a.out, "--out", inputs);
+    check_output_path(a.stats, "--stats", inputs);
+    vk::ContextOptions copt;
+    copt.device = vk::parse_device_choice(a.device);
     SceneLoadOptions lo;
     lo.neural_glob = a.neural_glob;
     Scene scene = load_scene_arg(a.scene, lo);
@@ -106,13 +111,11 @@ void run_render(const RenderArgs& a) {
         std::printf("%s", render::explain(render::derive_features(scene, env), a.options.max_depth).c_str());
         return;
     }
+    vk::Context ctx(copt); // before the BVH build: a missing device fails fast
     const auto t0 = std::chrono::steady_clock::now();
     const SceneAccel accel = build_scene_accel(scene);
     log_info("render: BVHs built in %.1f ms", std::chrono::duration<double, std::milli>(
                                                   std::chrono::steady_clock::now() - t0).count());
-    vk::ContextOptions copt;
-    copt.device = vk::parse_device_choice(a.device);
-    vk::Context ctx(copt);
     render::WavefrontRenderer renderer(ctx, scene, accel, env, camera, options);
     render::RenderResult result = renderer.render();
     const render::RenderStats& s = result.stats;
