@@ -7,6 +7,7 @@
 #include <string>
 
 #include "app/commands.h"
+#include "app/output_path.h"
 #include "assets/default_scene.h"
 #include "engine/core/error.h"
 #include "engine/core/log.h"
@@ -52,6 +53,13 @@ void run_train(const TrainArgs& a) {
     opt.seed = a.seed;
     opt.threads = a.threads;
     validate(opt);
+    // Output paths are checked before the (minutes-long) training, and never replace the input scene.
+    const std::string out = a.out.empty()
+                                ? (a.scene == "default" ? std::string("default.nbvh")
+                                                        : std::filesystem::path(a.scene).stem().string() + ".nbvh")
+                                : a.out;
+    check_output_path(out, "--out", {a.scene});
+    check_output_path(a.log_csv, "--log", {a.scene, out});
 
     Scene scene;
     uint64_t source_hash = 0;
@@ -65,6 +73,12 @@ void run_train(const TrainArgs& a) {
         scene = load_gltf(a.scene, lo);
         source_hash = fnv1a64_file(a.scene);
     }
+    if (!a.neural_glob.empty()) {
+        bool matched = false;
+        for (const Instance& inst : scene.instances) matched = matched || inst.neural;
+        if (!matched)
+            throw Error(strfmt("--neural '%s' matches no node of '%s'", a.neural_glob.c_str(), a.scene.c_str()));
+    }
     const uint32_t mesh = pick_neural_mesh(scene);
     uint32_t neural_meshes = 0;
     {
@@ -77,10 +91,6 @@ void run_train(const TrainArgs& a) {
                  scene.meshes[mesh].name.c_str());
     const TrainingAsset asset = make_training_asset(scene, mesh);
 
-    const std::string out = a.out.empty()
-                                ? (a.scene == "default" ? std::string("default.nbvh")
-                                                        : std::filesystem::path(a.scene).stem().string() + ".nbvh")
-                                : a.out;
     if (a.deterministic) setenv("NBVH_CUDA_DETERMINISTIC", "1", 1); // read by the CUDA backend
     std::unique_ptr<TrainerBackend> be = make_backend(backend, asset, opt);
     const SplitSchedule schedule = make_split_schedule(opt);
