@@ -21,13 +21,17 @@ Adam::Adam(const AdamConfig& cfg, size_t mlp_params, size_t grid_params)
       grid_v_(grid_params, 0.0f), mlp_t_(mlp_params, 0u), grid_t_(grid_params, 0u) {}
 
 namespace {
-// One parameter's update; returns false when skipped.
-inline void adam_update(float& w, float g, float& m, float& v, uint32_t& t, float l2, float lr, const AdamConfig& c) {
+float bias_sqrt(const AdamConfig& c, uint32_t ti) { return std::sqrt(1.0f - std::pow(c.beta2, float(ti))); }
+float bias_div(const AdamConfig& c, uint32_t ti) { return 1.0f - std::pow(c.beta1, float(ti)); }
+
+// One parameter's update; returns false when skipped. bs/bd: bias_sqrt/bias_div by t (t < size).
+inline void adam_update(float& w, float g, float& m, float& v, uint32_t& t, float l2, float lr, const AdamConfig& c,
+                        const std::vector<float>& bs, const std::vector<float>& bd) {
     g += l2 * w;
     m = c.beta1 * m + (1.0f - c.beta1) * g;
     v = c.beta2 * v + (1.0f - c.beta2) * g * g;
     const uint32_t ti = ++t;
-    const float lr_t = lr * std::sqrt(1.0f - std::pow(c.beta2, float(ti))) / (1.0f - std::pow(c.beta1, float(ti)));
+    const float lr_t = ti < bs.size() ? lr * bs[ti] / bd[ti] : lr * bias_sqrt(c, ti) / bias_div(c, ti);
     w -= lr_t / (std::sqrt(v) + c.epsilon) * m;
 }
 } // namespace
@@ -37,12 +41,20 @@ void Adam::step(NetworkWeights& w, const std::vector<float>& mlp_grad, const std
     NBVH_CHECK(w.grid.size() == grid_m_.size() && grid_grad.size() == grid_m_.size());
     const float lr = lr_at_step(cfg_, steps_);
     const float inv_scale = 1.0f / cfg_.loss_scale;
+    // Every counter is at most steps_ before this step, so t <= steps_ + 1 after it.
+    while (bias_sqrt_.size() < steps_ + 2) {
+        const uint32_t ti = uint32_t(bias_sqrt_.size());
+        bias_sqrt_.push_back(bias_sqrt(cfg_, ti));
+        bias_div_.push_back(bias_div(cfg_, ti));
+    }
     for (size_t i = 0; i < w.mlp.size(); ++i)
-        adam_update(w.mlp[i], mlp_grad[i] * inv_scale, mlp_m_[i], mlp_v_[i], mlp_t_[i], cfg_.l2_reg, lr, cfg_);
+        adam_update(w.mlp[i], mlp_grad[i] * inv_scale, mlp_m_[i], mlp_v_[i], mlp_t_[i], cfg_.l2_reg, lr, cfg_, bias_sqrt_,
+                    bias_div_);
     for (size_t i = 0; i < w.grid.size(); ++i) {
         const float g = grid_grad[i] * inv_scale;
         if (g == 0.0f && cfg_.skip_zero_grad_non_matrix) continue;
-        adam_update(w.grid[i], g, grid_m_[i], grid_v_[i], grid_t_[i], cfg_.non_matrix_l2_reg, lr, cfg_);
+        adam_update(w.grid[i], g, grid_m_[i], grid_v_[i], grid_t_[i], cfg_.non_matrix_l2_reg, lr, cfg_, bias_sqrt_,
+                    bias_div_);
     }
     ++steps_;
 }

@@ -57,6 +57,9 @@ private:
     uint64_t steps_ = 0;
     std::vector<float> mlp_m_, mlp_v_, grid_m_, grid_v_;
     std::vector<uint32_t> mlp_t_, grid_t_;
+    // Bias-correction factors by per-parameter step t (sqrt(1 - beta2^t) and 1 - beta1^t), computed
+    // once per t instead of two powf per parameter and step; identical values.
+    std::vector<float> bias_sqrt_, bias_div_;
 };
 
 } // namespace nbvh::neural

@@ -1,12 +1,15 @@
 #include "trainer/cpu/cpu_backend.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <memory>
 #include <thread>
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/neural/adam.h"
+#include "engine/neural/batched_network.h"
 #include "engine/neural/losses.h"
 #include "shaders/shared/neural_query.h"
 #include "trainer/ground_truth.h"
@@ -63,6 +66,10 @@ public:
         per_thread_.resize(threads_);
         mlp_grad_.assign(weights_.mlp.size(), 0.0f);
         grid_grad_.assign(weights_.grid.size(), 0.0f);
+        // A dense grid gradient per thread while the table is small (2^15 CPU default: ~0.8 M values);
+        // bigger tables (2^18 paper default: 5.4 M values = 21 MiB per thread, cleared and reduced
+        // every step) collect (index, grad) pairs instead (~0.8 M pairs per 1024 samples).
+        dense_grid_ = weights_.grid.size() <= kDenseGridValues;
     }
 
     const char* name() const override { return "cpu"; }
@@ -77,46 +84,58 @@ public:
 
         auto work = [&](unsigned t) {
             ThreadState& ts = per_thread_[t];
-            ts.reset(weights_, leaves);
+            ts.reset(weights_, leaves, dense_grid_);
+            if (!ts.tile) ts.tile = neural::make_batch_tile();
+            neural::BatchTile& tile = *ts.tile;
+            const neural::GridGradSink sink{dense_grid_ ? ts.grid_grad.data() : nullptr,
+                                            dense_grid_ ? nullptr : &ts.grid_sparse};
             const uint32_t begin = uint32_t(uint64_t(batch) * t / n_threads);
             const uint32_t end = uint32_t(uint64_t(batch) * (t + 1) / n_threads);
-            neural::ForwardCache cache;
-            for (uint32_t i = begin; i < end; ++i) {
-                // One stream per (step, slot): reproducible whatever the thread count.
-                Pcg32 rng(params.seed ^ (uint64_t(params.step) * 0x9E3779B97F4A7C15ull), i);
-                const TrainingSample s =
-                    draw_training_sample(asset_, params.cuts, rng, ts.leaf_draws.data(), ts.draws);
-                if (s.leaf < 0) continue; // starved (no reachable leaf): counted as not trained
-                const GroundTruth gt = trace_ground_truth(asset_, s.origin, s.dir, 0.0f, s.length);
-                neural::SegmentQuery q;
-                nb_segment_points(asset_.encoding, s.origin, s.dir, 0.0f, s.length, q.points[0], q.points[1],
-                                  q.points[2]);
-                const neural::Outputs y = neural::forward(weights_, q, neural::Precision::fp32, &cache);
-                if (!std::isfinite(y[0] + y[1] + y[2] + y[3] + y[4] + y[5] + y[6] + y[7])) {
-                    ts.non_finite = true; // reported as a skipped step; never fed to the loss
-                    continue;
+            // Slots are drawn in order and trained in tiles of kBatchTile samples (batched network).
+            std::array<neural::SegmentQuery, neural::kBatchTile> queries;
+            std::array<TileSample, neural::kBatchTile> meta;
+            for (uint32_t i = begin; i < end;) {
+                uint32_t n = 0;
+                for (; i < end && n < neural::kBatchTile; ++i) {
+                    // One stream per (step, slot): reproducible whatever the thread count.
+                    Pcg32 rng(params.seed ^ (uint64_t(params.step) * 0x9E3779B97F4A7C15ull), i);
+                    const TrainingSample s =
+                        draw_training_sample(asset_, params.cuts, rng, ts.leaf_draws.data(), ts.draws);
+                    if (s.leaf < 0) continue; // starved (no reachable leaf): counted as not trained
+                    const GroundTruth gt = trace_ground_truth(asset_, s.origin, s.dir, 0.0f, s.length);
+                    nb_segment_points(asset_.encoding, s.origin, s.dir, 0.0f, s.length, queries[n].points[0],
+                                      queries[n].points[1], queries[n].points[2]);
+                    meta[n] = {neural::make_targets(gt.hit, gt.depth, gt.normal, gt.albedo), gt.hit, s.cut, s.leaf};
+                    n++;
                 }
-                const neural::Targets target = neural::make_targets(gt.hit, gt.depth, gt.normal, gt.albedo);
-                neural::Outputs dl_dy{};
-                std::array<float, NB_MLP_OUTPUTS> slot{};
-                const float total = neural::composite_loss(y, target, loss_cfg_, &dl_dy, &slot);
-                ts.grads.grid.clear();
-                neural::backward(weights_, cache, dl_dy, ts.grads);
-                for (const neural::GridGrad<float>& g : ts.grads.grid) ts.grid_grad[g.index] += g.grad;
-                // Unweighted terms for the log; normal and albedo as means over their 3 channels.
-                ts.terms.visibility += slot[NB_OUT_VISIBILITY] / loss_cfg_.w_visibility;
-                ts.terms.depth += slot[NB_OUT_DEPTH] / loss_cfg_.w_depth;
-                ts.terms.normal += (slot[NB_OUT_NORMAL] + slot[NB_OUT_NORMAL + 1] + slot[NB_OUT_NORMAL + 2]) /
-                                   (3.0f * loss_cfg_.w_normal);
-                ts.terms.albedo += (slot[NB_OUT_ALBEDO] + slot[NB_OUT_ALBEDO + 1] + slot[NB_OUT_ALBEDO + 2]) /
-                                   (3.0f * loss_cfg_.w_albedo);
-                ts.terms.total += total;
-                ts.samples++;
-                if (gt.hit) ts.hits++;
-                if (s.cut == 0) {
-                    ts.leaf_loss[size_t(s.leaf)] += total;
-                    ts.leaf_samples[size_t(s.leaf)]++;
+                if (n == 0) break;
+                neural::forward_tile(weights_, std::span<const neural::SegmentQuery>(queries.data(), n), tile);
+                for (uint32_t j = 0; j < n; ++j) {
+                    const neural::Outputs y = tile.output(j);
+                    if (!std::isfinite(y[0] + y[1] + y[2] + y[3] + y[4] + y[5] + y[6] + y[7])) {
+                        ts.non_finite = true; // reported as a skipped step; never fed to the loss
+                        continue;             // (its dL/dy stays 0; the step is skipped anyway)
+                    }
+                    neural::Outputs dl_dy{};
+                    std::array<float, NB_MLP_OUTPUTS> slot{};
+                    const float total = neural::composite_loss(y, meta[j].target, loss_cfg_, &dl_dy, &slot);
+                    tile.set_dl_dy(j, dl_dy);
+                    // Unweighted terms for the log; normal and albedo as means over their 3 channels.
+                    ts.terms.visibility += slot[NB_OUT_VISIBILITY] / loss_cfg_.w_visibility;
+                    ts.terms.depth += slot[NB_OUT_DEPTH] / loss_cfg_.w_depth;
+                    ts.terms.normal += (slot[NB_OUT_NORMAL] + slot[NB_OUT_NORMAL + 1] + slot[NB_OUT_NORMAL + 2]) /
+                                       (3.0f * loss_cfg_.w_normal);
+                    ts.terms.albedo += (slot[NB_OUT_ALBEDO] + slot[NB_OUT_ALBEDO + 1] + slot[NB_OUT_ALBEDO + 2]) /
+                                       (3.0f * loss_cfg_.w_albedo);
+                    ts.terms.total += total;
+                    ts.samples++;
+                    if (meta[j].hit) ts.hits++;
+                    if (meta[j].cut == 0) {
+                        ts.leaf_loss[size_t(meta[j].leaf)] += total;
+                        ts.leaf_samples[size_t(meta[j].leaf)]++;
+                    }
                 }
+                neural::backward_tile(weights_, tile, ts.grads.mlp.data(), sink);
             }
         };
         if (n_threads == 1) {
@@ -152,7 +171,10 @@ public:
                 st.leaves[i].draws += ts.leaf_draws[i];
             }
             for (size_t i = 0; i < mlp_grad_.size(); ++i) mlp_grad_[i] += ts.grads.mlp[i];
-            for (size_t i = 0; i < grid_grad_.size(); ++i) grid_grad_[i] += ts.grid_grad[i];
+            if (dense_grid_)
+                for (size_t i = 0; i < grid_grad_.size(); ++i) grid_grad_[i] += ts.grid_grad[i];
+            else
+                for (const neural::GridGrad<float>& g : ts.grid_sparse) grid_grad_[g.index] += g.grad;
         }
         if (st.samples == 0) {
             st.skipped = true;
@@ -186,18 +208,31 @@ public:
     }
 
 private:
+    // Per drawn sample of a tile: what the loss needs after the batched forward.
+    struct TileSample {
+        neural::Targets target{};
+        bool hit = false;
+        uint32_t cut = 0;
+        int32_t leaf = -1;
+    };
+
     struct ThreadState {
-        neural::Gradients grads;
-        std::vector<float> grid_grad;
+        neural::Gradients grads;                         // .mlp used (dense); .grid unused
+        std::vector<float> grid_grad;                    // dense grid gradient (small tables)
+        std::vector<neural::GridGrad<float>> grid_sparse; // sparse grid gradient (large tables)
+        std::unique_ptr<neural::BatchTile> tile;
         std::vector<double> leaf_loss;
         std::vector<uint32_t> leaf_samples, leaf_draws;
         LossTerms terms;
         uint32_t samples = 0, hits = 0;
         uint64_t draws = 0;
         bool non_finite = false;
-        void reset(const neural::NetworkWeights& w, size_t leaves) {
+        void reset(const neural::NetworkWeights& w, size_t leaves, bool dense) {
             grads.reset();
-            grid_grad.assign(w.grid.size(), 0.0f);
+            if (dense)
+                grid_grad.assign(w.grid.size(), 0.0f);
+            else
+                grid_sparse.clear();
             leaf_loss.assign(leaves, 0.0);
             leaf_samples.assign(leaves, 0u);
             leaf_draws.assign(leaves, 0u);
@@ -215,6 +250,8 @@ private:
     unsigned threads_ = 1;
     std::vector<ThreadState> per_thread_;
     std::vector<float> mlp_grad_, grid_grad_;
+    static constexpr size_t kDenseGridValues = size_t(1) << 22;
+    bool dense_grid_ = true;
 };
 
 } // namespace

@@ -1,7 +1,7 @@
 // The portable CPU training backend: the numerical reference of the trainer. Multi-threaded over the
-// batch with std::thread; each thread samples its share of rays, traces the ground truth, runs the CPU
-// reference network (engine/neural/reference_network.h) forward and backward, and accumulates dense
-// gradients; the host thread reduces them, checks them for non-finite values and runs Adam
+// batch with std::thread; each thread samples its share of rays, traces the ground truth, runs the
+// network forward and backward in tiles of 64 samples (engine/neural/batched_network.h: the CPU
+// reference's math as small matrix-matrix products) and accumulates per-thread gradients; the host thread reduces them, checks them for non-finite values and runs Adam
 // (engine/neural/adam.h) on the fp32 master weights.
 #pragma once
 #include <cstdint>
