@@ -2,7 +2,7 @@
 //                   [--camera ex,ey,ez,tx,ty,tz,fov] [--env FILE.hdr|.exr] [--stats FILE.json] [--explain]
 //                   [--model M.nbvh [--lod L] [--secondary-lod L] [--neural-path auto|scalar|coopmat]]
 //                   [--classical] [--neural GLOB] [--neural-roughness R] [--neural-metallic M]
-//                   [--neural-max-leaves N]
+//                   [--neural-max-leaves N] [--neural-batched-rounds N]
 // With --model the scene's neural instances are rendered from the model (hybrid); --classical renders
 // them from their triangles with the same material constants (the reference FLIP compares against).
 // Loads the scene, builds its BVHs, runs the wavefront path tracer (engine/render/) and writes the image
@@ -167,6 +167,8 @@ void add_render_command(CLI::App& app) {
     cmd->add_option("--neural-metallic", args->options.neural.metallic, "metallic of neural surfaces [0,1]");
     cmd->add_option("--neural-max-leaves", args->options.neural.max_rounds,
                     "neural leaves queried per ray at most (then the closest hit so far is kept)");
+    cmd->add_option("--neural-batched-rounds", args->options.neural.batched_rounds,
+                    "leaf rounds through the batched query pass before the per-ray tail pass");
     cmd->callback([args] { run_render(*args); });
 }
 

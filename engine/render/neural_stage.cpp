@@ -15,6 +15,7 @@ void validate(const NeuralRenderOptions& o, const Scene& scene) {
     if (!(o.roughness >= 0.0f && o.roughness <= 1.0f)) throw Error("--neural-roughness must be in [0, 1]");
     if (!(o.metallic >= 0.0f && o.metallic <= 1.0f)) throw Error("--neural-metallic must be in [0, 1]");
     if (o.max_rounds == 0 || o.max_rounds > 256) throw Error("--neural-max-leaves must be in 1..256");
+    if (o.batched_rounds > 256) throw Error("--neural-batched-rounds must be in 0..256");
     if (!(o.threshold > 0.0f && o.threshold < 1.0f)) throw Error("the visibility threshold must be in (0, 1)");
     bool any = false;
     for (const Instance& i : scene.instances) any = any || i.neural;
@@ -68,7 +69,7 @@ void apply_classical_materials(const Scene& scene, GpuSceneData& data, float rou
 NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const NeuralRenderOptions& o,
                          uint32_t ray_capacity)
     : ctx_(ctx), model_(ctx, model), kernel_(choose_neural_kernel(ctx.features(), o.path)),
-      rounds_(o.max_rounds), capacity_(ray_capacity) {
+      rounds_(o.max_rounds), batched_(std::min(o.max_rounds, o.batched_rounds)), capacity_(ray_capacity) {
     params_.box = model_.box();
     params_.root_primary = model_.lod_root(o.lod);
     params_.root_secondary = model_.lod_root(o.secondary_lod < 0 ? o.lod : uint32_t(o.secondary_lod));

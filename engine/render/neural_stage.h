@@ -4,9 +4,12 @@
 //
 // Per path-ray bounce the renderer records (engine/render/README.md):
 //   neural_traverse(op 0, all rays) -> [neural_args -> neural_query -> neural_traverse(op 1, the rays
-//   just queried)] x rounds -> neural_traverse(op 2) -> shade
+//   just queried)] x batched rounds -> neural_args -> neural_tail -> neural_traverse(op 2) -> shade
 // instead of traverse, and for shadow rays
-//   neural_shadow(op 0) -> [neural_args -> neural_query -> neural_shadow(op 1)] x rounds -> shadow
+//   neural_shadow(op 0) -> [neural_args -> neural_query -> neural_shadow(op 1)] x batched rounds
+//   -> neural_args -> neural_tail -> shadow
+// neural_tail finishes the few rays still going after the batched rounds in one pass (scalar queries
+// inline), which saves the fixed cost of three dependent dispatches per extra round.
 // The pending queue has two halves: a round's traversal reads its rays from the half just queried and
 // queues into the other (pass constant mode bit 2, shaders/lib/neural_traverse.glsl).
 #pragma once
@@ -32,6 +35,7 @@ struct NeuralRenderOptions {
     float roughness = 0.5f;             // material constants of neural surfaces
     float metallic = 0.0f;
     uint32_t max_rounds = 16;           // leaves queried per ray at most
+    uint32_t batched_rounds = 4;        // rounds through the batched query pass; the rest: neural_tail
     float threshold = NB_VISIBILITY_THRESHOLD;
 };
 
@@ -59,6 +63,7 @@ public:
     const NeuralKernelChoice& kernel() const { return kernel_; }
     const char* query_shader() const;
     uint32_t rounds() const { return rounds_; }
+    uint32_t batched_rounds() const { return batched_; }
     const GpuNeuralParams& params() const { return params_; }
 
 private:
@@ -67,6 +72,7 @@ private:
     NeuralKernelChoice kernel_;
     GpuNeuralParams params_{};
     uint32_t rounds_ = 0;
+    uint32_t batched_ = 0;
     uint32_t capacity_ = 0;
 };
 

@@ -15,7 +15,7 @@ namespace {
 
 enum Pass : size_t {
     CAMERA, QUEUE_ARGS, TRAVERSE, SHADE, SHADOW, ACCUMULATE, RESOLVE,
-    NEURAL_TRAVERSE, NEURAL_ARGS, NEURAL_QUERY, NEURAL_SHADOW, // hybrid renders only (neural_stage.h)
+    NEURAL_TRAVERSE, NEURAL_ARGS, NEURAL_QUERY, NEURAL_SHADOW, NEURAL_TAIL, // hybrid renders only (neural_stage.h)
     PASS_COUNT
 };
 // NEURAL_QUERY's shader depends on the MLP path (NeuralStage::query_shader); this entry names its timer.
@@ -24,7 +24,7 @@ const char* const PASS_SHADERS[PASS_COUNT] = {"passes/camera_rays.comp", "passes
                                               "passes/shadow.comp",      "passes/accumulate.comp",
                                               "passes/resolve.comp",     "passes/neural_traverse.comp",
                                               "passes/neural_args.comp", "passes/neural_query.comp",
-                                              "passes/neural_shadow.comp"};
+                                              "passes/neural_shadow.comp", "passes/neural_tail.comp"};
 
 template <class T> vk::Buffer upload(const vk::Context& ctx, const std::vector<T>& items, const char* name) {
     return vk::make_buffer(ctx, items, name);
@@ -151,7 +151,7 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
         for (uint32_t b = 0; b < NB_NEURAL_BINDING_END; ++b) set.bind(b, buffers_[b]);
         sets_.push_back(std::move(set));
     }
-    timer_ = vk::GpuTimer(ctx_, 64 + (8 + (neural_ ? 6 * neural_->rounds() + 4 : 0)) * options_.max_depth);
+    timer_ = vk::GpuTimer(ctx_, 64 + (8 + (neural_ ? 6 * neural_->batched_rounds() + 8 : 0)) * options_.max_depth);
     cmd_ = vk::CommandBuffer(ctx_, "wavefront");
 }
 
@@ -195,13 +195,17 @@ void WavefrontRenderer::record_neural_rounds(vk::CommandBuffer& cmd, size_t trav
                                              uint32_t sample, uint32_t offset, uint32_t count) {
     const Dispatch all = traverse_pass == NEURAL_SHADOW ? Dispatch::indirect_shadow : Dispatch::indirect_rays;
     record_pass(cmd, traverse_pass, constants(q, depth, sample, offset, count, 0), all);
-    for (uint32_t round = 0; round < neural_->rounds(); ++round) {
+    const uint32_t batched = neural_->batched_rounds();
+    for (uint32_t round = 0; round < batched; ++round) {
         const uint32_t half = round & 1u;
         record_pass(cmd, NEURAL_ARGS, constants(q, depth, sample, offset, count, 0), Dispatch::single);
         record_pass(cmd, NEURAL_QUERY, constants(q, depth, sample, offset, count, half << 2), Dispatch::indirect_pending);
         record_pass(cmd, traverse_pass, constants(q, depth, sample, offset, count, 1u | ((half ^ 1u) << 2)),
                     Dispatch::indirect_pending);
     }
+    // The few rays left finish in one pass (query, resume, query, ... per invocation).
+    record_pass(cmd, NEURAL_ARGS, constants(q, depth, sample, offset, count, 0), Dispatch::single);
+    record_pass(cmd, NEURAL_TAIL, constants(q, depth, sample, offset, count, (batched & 1u) << 2), Dispatch::indirect_pending);
 }
 
 void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, uint32_t sample, uint32_t offset, uint32_t count) {

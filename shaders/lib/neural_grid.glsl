@@ -16,28 +16,34 @@
 // conversion of packHalf2x16 is correctly rounded in Vulkan). Saturates to +-inf like fp16.
 float nb_round_half(float x) { return unpackHalf2x16(packHalf2x16(vec2(x, 0.0f))).x; }
 
-// The 32 features (level-major, 4 per level) of one encoded point, each already rounded to fp16.
+// The 4 features of level l of one encoded point, each already rounded to fp16.
+vec4 nb_neural_level_features(vec3 p, uint l) {
+    GpuHashLevel lv = neural_levels[l];
+    uvec3 cell;
+    vec3 frac;
+    nb_grid_position(lv, p, cell, frac);
+    vec4 sum = vec4(0.0f);
+    for (uint c = 0u; c < NB_GRID_CORNERS; ++c) {
+        float w = nb_grid_corner_weight(frac, c);
+        uvec2 e = neural_grid[nb_grid_corner_entry(lv, cell, c)];
+        vec4 v = vec4(unpackHalf2x16(e.x), unpackHalf2x16(e.y));
+        // Separate multiply and add per component, in corner order (the CPU reference's order).
+        sum.x += w * v.x;
+        sum.y += w * v.y;
+        sum.z += w * v.z;
+        sum.w += w * v.w;
+    }
+    return vec4(nb_round_half(sum.x), nb_round_half(sum.y), nb_round_half(sum.z), nb_round_half(sum.w));
+}
+
+// The 32 features (level-major, 4 per level) of one encoded point.
 void nb_neural_point_features(vec3 p, out float f[NB_POINT_FEATURES]) {
     for (uint l = 0u; l < NB_GRID_MAX_LEVELS; ++l) {
-        GpuHashLevel lv = neural_levels[l];
-        uvec3 cell;
-        vec3 frac;
-        nb_grid_position(lv, p, cell, frac);
-        vec4 sum = vec4(0.0f);
-        for (uint c = 0u; c < NB_GRID_CORNERS; ++c) {
-            float w = nb_grid_corner_weight(frac, c);
-            uvec2 e = neural_grid[nb_grid_corner_entry(lv, cell, c)];
-            vec4 v = vec4(unpackHalf2x16(e.x), unpackHalf2x16(e.y));
-            // Separate multiply and add per component, in corner order (the CPU reference's order).
-            sum.x += w * v.x;
-            sum.y += w * v.y;
-            sum.z += w * v.z;
-            sum.w += w * v.w;
-        }
-        f[l * 4u + 0u] = nb_round_half(sum.x);
-        f[l * 4u + 1u] = nb_round_half(sum.y);
-        f[l * 4u + 2u] = nb_round_half(sum.z);
-        f[l * 4u + 3u] = nb_round_half(sum.w);
+        vec4 v = nb_neural_level_features(p, l);
+        f[l * 4u + 0u] = v.x;
+        f[l * 4u + 1u] = v.y;
+        f[l * 4u + 2u] = v.z;
+        f[l * 4u + 3u] = v.w;
     }
 }
 

@@ -95,17 +95,20 @@ void nb_mlp_forward_coopmat() {
     barrier();
 }
 
-// Writes one query's 96 features (rounded to fp16, R1) into its row of nb_sh_x; zeros when !valid.
+// Writes one query's 96 features (rounded to fp16, R1) into its row of nb_sh_x, level by level (no
+// per-point array stays live); zeros when !valid.
 void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
-    float f[NB_POINT_FEATURES];
+    uint base = local * NB_COOP_STRIDE;
     for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
-        if (valid) {
-            nb_neural_point_features(k == 0u ? p0 : (k == 1u ? p1 : p2), f);
-        } else {
-            for (uint i = 0u; i < NB_POINT_FEATURES; ++i) f[i] = 0.0f;
+        vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
+        for (uint l = 0u; l < NB_GRID_MAX_LEVELS; ++l) {
+            vec4 v = valid ? nb_neural_level_features(p, l) : vec4(0.0f);
+            uint o = base + nb_feature_slot(k, l, 0u);
+            nb_sh_x[o] = float16_t(v.x);
+            nb_sh_x[o + 1u] = float16_t(v.y);
+            nb_sh_x[o + 2u] = float16_t(v.z);
+            nb_sh_x[o + 3u] = float16_t(v.w);
         }
-        for (uint i = 0u; i < NB_POINT_FEATURES; ++i)
-            nb_sh_x[local * NB_COOP_STRIDE + k * NB_POINT_FEATURES + i] = float16_t(f[i]);
     }
 }
 

@@ -100,6 +100,16 @@ void nb_nl_begin(GpuNeuralRayState st, uint root) {
     g_nl_cand_inst = NB_NO_HIT;
 }
 
+// A path ray with no leaf left: a neural hit closer than the triangle hit replaces it in the hit SOA.
+void nb_nl_finish_path(uint i, inout GpuNeuralRayState st) {
+    st.status = NB_NRAY_DONE;
+    if (st.best_t < st.tri_t) {
+        hit_store1(NB_HIT_T, i, floatBitsToUint(st.best_t));
+        hit_store1(NB_HIT_INSTANCE, i, st.instance);
+        hit_store1(NB_HIT_TRIANGLE, i, NB_NEURAL_TRIANGLE);
+    }
+}
+
 GpuNeuralRayState nb_nl_fresh_state() {
     GpuNeuralRayState st;
     st.normal = vec3(0.0f, 0.0f, 1.0f);

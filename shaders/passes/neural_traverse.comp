@@ -5,8 +5,8 @@
 //   1: the rays of the pairs just queried (pending half nb_nl_half(pc.mode) ^ 1, dispatched indirectly
 //      over them): re-traverse the neural instances only (triangles are known), culled by
 //      min(triangle hit, best neural hit), and queue the next leaf into half nb_nl_half(pc.mode);
-//   2: every ray: rays still undecided keep the best hit found so far (safety net; with as many rounds
-//      as the per-ray leaf budget none is left).
+//   2: every ray: rays still undecided keep the best hit found so far (safety net: after the last
+//      batched round passes/neural_tail.comp finishes every ray).
 // A ray is finished when no leaf key remains in front of its best hit; then a closer neural hit
 // replaces the triangle hit in the hit SOA (triangle word NB_NEURAL_TRIANGLE).
 #version 460
@@ -14,15 +14,6 @@
 #include "lib/traverse.glsl"
 
 layout(local_size_x = NB_WAVEFRONT_GROUP) in;
-
-void finish(uint i, inout GpuNeuralRayState st) {
-    st.status = NB_NRAY_DONE;
-    if (st.best_t < st.tri_t) {
-        hit_store1(NB_HIT_T, i, floatBitsToUint(st.best_t));
-        hit_store1(NB_HIT_INSTANCE, i, st.instance);
-        hit_store1(NB_HIT_TRIANGLE, i, NB_NEURAL_TRIANGLE);
-    }
-}
 
 void main() {
     uint op = nb_nl_op(pc.mode);
@@ -43,7 +34,7 @@ void main() {
             if (i == 0u) counters.pending_count = 0u; // nothing queued remains for the shadow loop
             st = neural_state[i];
             if (st.status == NB_NRAY_DONE) return;
-            finish(i, st);
+            nb_nl_finish_path(i, st);
             neural_state[i] = st;
             return;
         }
@@ -68,6 +59,6 @@ void main() {
         g_nl_skip_triangles = true;
         nb_trace(org, dir, t_resume, min(st.tri_t, st.best_t), false);
     }
-    if (!nb_nl_queue_candidate(i, half_, min(st.tri_t, st.best_t), st)) finish(i, st);
+    if (!nb_nl_queue_candidate(i, half_, min(st.tri_t, st.best_t), st)) nb_nl_finish_path(i, st);
     neural_state[i] = st;
 }

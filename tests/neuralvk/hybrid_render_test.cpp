@@ -67,7 +67,7 @@ struct Rendered {
 };
 
 Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPath::scalar, float threshold = 0.5f,
-                      uint32_t lod = 0, int32_t secondary_lod = -1) {
+                      uint32_t lod = 0, int32_t secondary_lod = -1, uint32_t batched_rounds = 4) {
     vk::ContextOptions co;
     co.device = vk::DeviceChoice::cpu;
     co.validation = true;
@@ -86,6 +86,7 @@ Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPat
     o.neural.threshold = threshold;
     o.neural.lod = lod;
     o.neural.secondary_lod = secondary_lod;
+    o.neural.batched_rounds = batched_rounds;
     if (hybrid) o.neural.model = &f.model;
     else o.neural.classical = true;
     WavefrontRenderer r(ctx, f.scene, accel, default_sky(), cam, o);
@@ -138,6 +139,26 @@ TEST(HybridRender, LevelOfDetailOptions) {
     EXPECT_EQ(f.model.lod_count, 2u);
     EXPECT_LT(fc, FLIP_BOUND);
     EXPECT_LT(fm, FLIP_BOUND);
+}
+
+// The per-ray tail pass (passes/neural_tail.comp) takes the same decisions as batched rounds: all rounds
+// batched, one batched round + tail, and everything in the tail give the same image.
+TEST(HybridRender, TailPassMatchesBatchedRounds) {
+    NBVH_REQUIRE_SHARED();
+    const Fixture& f = trained_bunny();
+    const Rendered all_batched = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 16);
+    const Rendered one = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 1);
+    const Rendered tail = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 0);
+    EXPECT_EQ(all_batched.validation + one.validation + tail.validation, 0);
+    const float f1 = flip_hdr(all_batched.image, one.image).mean;
+    const float f0 = flip_hdr(all_batched.image, tail.image).mean;
+    std::printf("batched 16 vs 1 + tail: FLIP %.2e; vs tail only: %.2e; queries %llu / %llu / %llu\n", f1, f0,
+                (unsigned long long)all_batched.stats.neural_queries, (unsigned long long)one.stats.neural_queries,
+                (unsigned long long)tail.stats.neural_queries);
+    EXPECT_LT(f1, 1e-3f);
+    EXPECT_LT(f0, 1e-3f);
+    EXPECT_EQ(all_batched.stats.neural_queries, one.stats.neural_queries);
+    EXPECT_EQ(all_batched.stats.neural_queries, tail.stats.neural_queries);
 }
 
 TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
