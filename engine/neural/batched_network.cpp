@@ -19,6 +19,10 @@
 #define NB_INLINE inline
 #endif
 
+#ifndef NBVH_PREFETCH_GROUP
+#define NBVH_PREFETCH_GROUP 4
+#endif
+
 namespace nbvh::neural {
 namespace {
 
@@ -26,8 +30,9 @@ constexpr uint32_t B = kBatchTile;
 constexpr uint32_t kW = NB_MLP_WIDTH;
 constexpr uint32_t kIn = NB_MLP_INPUTS;
 constexpr uint32_t kOut = NB_MLP_OUTPUTS;
-// Samples whose grid lines are prefetched together (8 x 192 lookups: a few hundred distinct lines).
-constexpr uint32_t kGroup = 8;
+// Samples whose grid lines are prefetched together, one group ahead (4 x 192 lookups; the coarse
+// levels' lines repeat, so a few hundred distinct lines are in flight at most).
+constexpr uint32_t kGroup = NBVH_PREFETCH_GROUP;
 
 inline void prefetch_read(const float* p) {
 #if defined(__GNUC__)
@@ -155,13 +160,12 @@ void forward_tile(const NetworkWeights& w, std::span<const SegmentQuery> queries
     std::fill(std::begin(t.x0), std::end(t.x0), 0.0f); // padding samples: zero features
     std::fill(std::begin(t.dy), std::end(t.dy), 0.0f);
     const float* grid = w.grid.data();
-    // Hash-grid encode: the reference's encode_point, split in two passes per group of samples so the
-    // grid reads (random, mostly cache misses) are independent of the index arithmetic and many are in
-    // flight at once: (1) corner value indices and weights of kGroup samples, prefetching their lines;
-    // (2) the trilinear sums in the reference's corner order. Indices/weights stay for the backward.
-    for (uint32_t g0 = 0; g0 < t.n; g0 += kGroup) {
-        const uint32_t g1 = std::min(t.n, g0 + kGroup);
-        for (uint32_t i = g0; i < g1; ++i) {
+    // Hash-grid encode: the reference's encode_point in two passes over groups of kGroup samples, so
+    // the grid reads (random, mostly cache misses) do not wait for index arithmetic: the corner value
+    // indices and weights of group g+1 are computed (and their lines prefetched) before the trilinear
+    // sums of group g (reference corner order). Indices/weights stay for the backward scatter.
+    auto lookups = [&](uint32_t g0) {
+        for (uint32_t i = g0; i < std::min(t.n, g0 + kGroup); ++i) {
             uint32_t* cv = t.corner_value + size_t(i) * BatchTile::kLookups;
             float* cw = t.corner_weight + size_t(i) * BatchTile::kLookups;
             for (uint32_t k = 0; k < NB_SEGMENT_POINTS; ++k)
@@ -177,9 +181,14 @@ void forward_tile(const NetworkWeights& w, std::span<const SegmentQuery> queries
                     }
                 }
         }
-        for (uint32_t i = g0; i < g1; ++i) {
+    };
+    if (t.n > 0) lookups(0);
+    for (uint32_t g0 = 0; g0 < t.n; g0 += kGroup) {
+        if (g0 + kGroup < t.n) lookups(g0 + kGroup);
+        for (uint32_t i = g0; i < std::min(t.n, g0 + kGroup); ++i) {
             const uint32_t* cv = t.corner_value + size_t(i) * BatchTile::kLookups;
             const float* cw = t.corner_weight + size_t(i) * BatchTile::kLookups;
+            // kl = k * levels + l, so nb_feature_slot(k, l, f) = kl * NB_GRID_FEATURES + f.
             for (uint32_t kl = 0; kl < NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS; ++kl) {
                 float acc[NB_GRID_FEATURES] = {};
                 for (uint32_t c = 0; c < NB_GRID_CORNERS; ++c, ++cv, ++cw)
@@ -195,12 +204,16 @@ void backward_tile(const NetworkWeights& w, BatchTile& t, float* mlp_grad, GridG
     NBVH_CHECK((sink.dense != nullptr) != (sink.sparse != nullptr));
     mlp_backward_kernel(w.mlp.data(), t, mlp_grad);
     // Grid: scatter dL/dfeature to the 8 corners of every level of every point (reference order),
-    // prefetching the destination lines of a group of samples first (dense sink: random writes).
+    // prefetching the destination lines of the next group of samples (dense sink: random writes).
+    auto prefetch_group = [&](uint32_t g0) {
+        const uint32_t g1 = std::min(t.n, g0 + kGroup);
+        for (uint32_t j = g0 * BatchTile::kLookups; j < g1 * BatchTile::kLookups; ++j)
+            prefetch_write(sink.dense + t.corner_value[j]);
+    };
+    if (sink.dense && t.n > 0) prefetch_group(0);
     for (uint32_t g0 = 0; g0 < t.n; g0 += kGroup) {
         const uint32_t g1 = std::min(t.n, g0 + kGroup);
-        if (sink.dense)
-            for (uint32_t j = g0 * BatchTile::kLookups; j < g1 * BatchTile::kLookups; ++j)
-                prefetch_write(sink.dense + t.corner_value[j]);
+        if (sink.dense && g1 < t.n) prefetch_group(g1);
         for (uint32_t i = g0; i < g1; ++i) {
             const uint32_t* cv = t.corner_value + size_t(i) * BatchTile::kLookups;
             const float* cw = t.corner_weight + size_t(i) * BatchTile::kLookups;
