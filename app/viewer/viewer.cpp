@@ -183,7 +183,7 @@ void run_viewer(const ViewerArgs& a) {
 
         OrbitCamera cam(home);
         std::unique_ptr<render::WavefrontRenderer> renderer;
-        bool rebuild = true, camera_moved = false;
+        bool rebuild = true, camera_moved = false, restart = false;
         Image film;
         std::vector<uint8_t> rgba;
         float shown_exposure = 0.0f;
@@ -200,19 +200,8 @@ void run_viewer(const ViewerArgs& a) {
                 height = fb_h;
                 rebuild = true;
             }
-            ui.new_frame();
-            PanelActions act;
-            info.width = width;
-            info.height = height;
-            if (s.show_ui) act = draw_panel(s, info);
-            camera_moved |= handle_input(cam, s, window, float(height));
-            if (act.reset_camera) {
-                cam.reset();
-                camera_moved = true;
-            }
-            ImGui::Render();
-
-            if (rebuild || act.rebuild) {
+            // Input of the previous frame's UI pass applies here, so the panel below shows this frame's numbers.
+            if (rebuild) {
                 render::RenderOptions o;
                 o.width = width;
                 o.height = height;
@@ -238,8 +227,8 @@ void run_viewer(const ViewerArgs& a) {
                 rebuild = false;
                 camera_moved = false;
             }
-            if (camera_moved || act.reset_accumulation) renderer->set_camera(cam.camera());
-            camera_moved = false;
+            if (camera_moved || restart) renderer->set_camera(cam.camera());
+            camera_moved = restart = false;
 
             const bool converged = s.max_samples > 0 && renderer->accumulated_samples() >= uint32_t(s.max_samples);
             bool new_film = false;
@@ -254,6 +243,19 @@ void run_viewer(const ViewerArgs& a) {
                 new_film = true;
             }
             info.samples = renderer->accumulated_samples();
+            info.width = width;
+            info.height = height;
+            ui.new_frame();
+            PanelActions act;
+            if (s.show_ui) act = draw_panel(s, info);
+            camera_moved |= handle_input(cam, s, window, float(height));
+            if (act.reset_camera) {
+                cam.reset();
+                camera_moved = true;
+            }
+            rebuild |= act.rebuild;
+            restart |= act.reset_accumulation;
+            ImGui::Render();
             if (new_film || shown_exposure != s.exposure || rgba.empty()) {
                 PngEncode enc;
                 enc.exposure = s.exposure;
