@@ -2,7 +2,7 @@
 //                   [--camera ex,ey,ez,tx,ty,tz,fov] [--env FILE.hdr|.exr] [--stats FILE.json] [--explain]
 //                   [--model M.nbvh [--lod L] [--secondary-lod L] [--neural-path auto|scalar|coopmat]]
 //                   [--classical] [--neural GLOB] [--neural-roughness R] [--neural-metallic M]
-//                   [--neural-max-leaves N] [--neural-batched-rounds N]
+//                   [--neural-max-leaves N] [--neural-batched-rounds N] [--wave-pixels N]
 // With --model the scene's neural instances are rendered from the model (hybrid); --classical renders
 // them from their triangles with the same material constants (the reference FLIP compares against).
 // Loads the scene, builds its BVHs, runs the wavefront path tracer (engine/render/) and writes the image
@@ -169,6 +169,9 @@ void add_render_command(CLI::App& app) {
                     "neural leaves queried per ray at most (then the closest hit so far is kept)");
     cmd->add_option("--neural-batched-rounds", args->options.neural.batched_rounds,
                     "leaf rounds through the batched query pass before the per-ray tail pass");
+    cmd->add_option("--wave-pixels", args->options.max_wave_pixels,
+                    "pixels traced per wave (rays per queue; clamped by the device's storage-buffer range)")
+        ->check(CLI::Range(64u, 1u << 26));
     cmd->callback([args] { run_render(*args); });
 }
 

@@ -34,8 +34,13 @@ struct NeuralRenderOptions {
     int32_t secondary_lod = -1;         // cut after the first hit (-1: same as lod)
     float roughness = 0.5f;             // material constants of neural surfaces
     float metallic = 0.0f;
-    uint32_t max_rounds = 16;           // leaves queried per ray at most
-    uint32_t batched_rounds = 4;        // rounds through the batched query pass; the rest: neural_tail
+    // Leaves queried per ray at most (then the closest hit so far is kept). 8: on the default scene at
+    // 1080p, 16 -> 8 -> 6 leaves changed FLIP against the classical reference by < 1e-4 (H200 v3/v4).
+    uint32_t max_rounds = 8;
+    // Rounds through the batched query pass; rays still going after them finish in neural_tail (one
+    // invocation per ray, scalar queries). Default: all rounds batched (the tail measured slower on the
+    // H200: its longest ray serialises ~10 scalar queries per pass).
+    uint32_t batched_rounds = 256;
     float threshold = NB_VISIBILITY_THRESHOLD;
 };
 
