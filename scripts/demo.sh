@@ -5,6 +5,12 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 mkdir -p out/demo
 # Train the default scene's neural asset (CUDA when a GPU is usable, else the CPU backend: ~1-2 min on 2 cores).
-build/app/nbvh train default --out out/demo/default.nbvh --log out/demo/train_log.csv
-build/app/nbvh render default --out out/demo/classical.png --stats out/demo/classical_stats.json
-echo "demo: wrote out/demo/classical.png"
+# An existing model is reused (delete out/demo/default.nbvh to retrain).
+if [[ ! -f out/demo/default.nbvh ]]; then
+  build/app/nbvh train default --out out/demo/default.nbvh --log out/demo/train_log.csv
+fi
+# Hybrid render (neural knot from the model) and the classical reference with the same material constants.
+build/app/nbvh render default --model out/demo/default.nbvh --out out/demo/neural.png --stats out/demo/neural_stats.json
+build/app/nbvh render default --classical --out out/demo/classical.png --stats out/demo/classical_stats.json
+build/app/nbvh flip out/demo/classical.png out/demo/neural.png --heatmap out/demo/flip.png | tee out/demo/flip.txt
+echo "demo: wrote out/demo/neural.png, out/demo/classical.png and out/demo/flip.png"
