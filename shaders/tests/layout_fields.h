@@ -19,6 +19,7 @@
 #include "../shared/neural_query.h"
 #include "../shared/scene_gpu.h"
 #include "../shared/wavefront_gpu.h"
+#include "../shared/neural_gpu.h"
 
 // --- every struct (name, binding in layout.comp) ------------------------------------------------
 #define NB_LAYOUT_STRUCTS(S) \
@@ -36,7 +37,13 @@
     S(GpuPendingLeaf, 11)    \
     S(GpuDispatchArgs, 12)   \
     S(GpuQueueCounters, 13)  \
-    S(GpuPassConstants, 14)
+    S(GpuPassConstants, 14)  \
+    S(GpuNeuralQuery, 15)    \
+    S(GpuNeuralHit, 16)      \
+    S(GpuNeuralEvalPush, 17) \
+    S(GpuNeuralRayState, 18) \
+    S(GpuNeuralParams, 19)   \
+    S(GpuNeuralCounters, 20)
 
 // --- field lists ---------------------------------------------------------------------------------
 #define NB_LAYOUT_FIELDS_GpuBvhNode(F) \
@@ -75,6 +82,18 @@
     F(rays_secondary) F(rays_shadow) F(nonfinite_samples)
 #define NB_LAYOUT_FIELDS_GpuPassConstants(F)                                                      \
     F(in_queue) F(depth) F(sample_index) F(pixel_offset) F(pixel_count) F(mode)
+#define NB_LAYOUT_FIELDS_GpuNeuralQuery(F) F(origin) F(t_entry) F(dir) F(t_exit)
+#define NB_LAYOUT_FIELDS_GpuNeuralHit(F) \
+    F(normal) F(t) F(albedo) F(visibility) F(depth) F(flags) F(pad0) F(pad1)
+#define NB_LAYOUT_FIELDS_GpuNeuralEvalPush(F) \
+    F(box.center) F(box.depth_pad) F(box.extent) F(box.fixed_depth_eps) F(count) F(threshold) F(pad0) F(pad1)
+#define NB_LAYOUT_FIELDS_GpuNeuralRayState(F)                                                     \
+    F(normal) F(best_t) F(albedo) F(instance) F(key_t) F(key_instance) F(key_leaf) F(status)      \
+    F(tri_t) F(tri_instance) F(tri_triangle) F(rounds)
+#define NB_LAYOUT_FIELDS_GpuNeuralParams(F)                                                       \
+    F(box.center) F(box.depth_pad) F(box.extent) F(box.fixed_depth_eps) F(root_primary)           \
+    F(root_secondary) F(roughness) F(metallic) F(threshold) F(max_rounds) F(pad0) F(pad1)
+#define NB_LAYOUT_FIELDS_GpuNeuralCounters(F) F(pending_active) F(queries_total) F(shadow_queries) F(rounds)
 
 // --- distinct, exactly representable, non-zero values ------------------------------------------
 // Field number k gets base value 16k (+1 for each further component), so every 4-byte word of a
