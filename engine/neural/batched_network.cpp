@@ -9,14 +9,14 @@
 // Two code paths of the MLP kernels chosen at load time (ifunc): x86-64-v3 (AVX2 + FMA) and the
 // build's baseline. Portable: other compilers/targets get the baseline only.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define NB_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#define NBVH_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else
-#define NB_CLONES
+#define NBVH_CLONES
 #endif
 #if defined(__GNUC__)
-#define NB_INLINE inline __attribute__((always_inline))
+#define NBVH_ALWAYS_INLINE inline __attribute__((always_inline))
 #else
-#define NB_INLINE inline
+#define NBVH_ALWAYS_INLINE inline
 #endif
 
 #ifndef NBVH_PREFETCH_GROUP
@@ -52,7 +52,7 @@ inline void prefetch_write(float* p) {
 // Y[r][b] = (relu?)(sum_c W[r][c] X[c][b]) for r < R: per (r, b) the sum runs over c in ascending
 // order, exactly as the reference's matvec; the inner loop is over the batch.
 template <uint32_t R, uint32_t C, bool kRelu>
-NB_INLINE void layer_forward(const float* __restrict W, const float* __restrict X, float* __restrict Y) {
+NBVH_ALWAYS_INLINE void layer_forward(const float* __restrict W, const float* __restrict X, float* __restrict Y) {
     for (uint32_t r = 0; r < R; ++r) {
         alignas(64) float acc[B] = {};
         const float* __restrict wr = W + r * C;
@@ -68,39 +68,53 @@ NB_INLINE void layer_forward(const float* __restrict W, const float* __restrict 
 
 // out[b][c] = in[c][b] for a [C][B] matrix.
 template <uint32_t C>
-NB_INLINE void transpose_to_samples(const float* __restrict in, float* __restrict out) {
+NBVH_ALWAYS_INLINE void transpose_to_samples(const float* __restrict in, float* __restrict out) {
     for (uint32_t c = 0; c < C; ++c)
         for (uint32_t b = 0; b < B; ++b) out[b * C + c] = in[c * B + b];
 }
 
+// 8 floats as one value (GCC vector extension: AVX register in the x86-64-v3 clone, two SSE
+// registers in the baseline); unaligned loads/stores through memcpy. The helpers are always inlined
+// into the kernels, so the -Wpsabi note (AVX vector return in a non-AVX function) does not apply.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+typedef float V8 __attribute__((vector_size(32)));
+NBVH_ALWAYS_INLINE V8 load8(const float* p) {
+    V8 v;
+    std::memcpy(&v, p, sizeof(v));
+    return v;
+}
+NBVH_ALWAYS_INLINE void store8(float* p, V8 v) { std::memcpy(p, &v, sizeof(v)); }
+
 // One matrix backward. dz: [R][B] dL/d(pre-activation). Adds dL/dW = sum_b dz[r][b] X[c][b] to G
-// (tile partial sums, samples in order, zero dz skipped as the reference does) and writes
+// (tile partial sums over the samples in order) and writes
 // dx[c][b] = sum_r W[r][c] dz[r][b] (rows in ascending order, as the reference), masked by the ReLU
 // of X when X is a hidden activation (derivative 0 at 0, as tcnn).
 template <uint32_t R, uint32_t C, bool kMaskRelu>
-NB_INLINE void layer_backward(const float* __restrict W, const float* __restrict X, const float* __restrict dz,
+NBVH_ALWAYS_INLINE void layer_backward(const float* __restrict W, const float* __restrict X, const float* __restrict dz,
                               float* __restrict xt, float* __restrict dzt, float* __restrict G,
                               float* __restrict dx) {
     transpose_to_samples<C>(X, xt);
     transpose_to_samples<R>(dz, dzt);
-    for (uint32_t r = 0; r < R; r += 2) {
-        // Two rows share the loads of each sample's input row.
-        alignas(64) float acc0[C] = {};
-        alignas(64) float acc1[C] = {};
-        for (uint32_t b = 0; b < B; ++b) {
-            const float d0 = dzt[b * R + r], d1 = dzt[b * R + r + 1];
-            if (d0 == 0.0f && d1 == 0.0f) continue;
-            const float* __restrict xb = xt + b * C;
-            for (uint32_t c = 0; c < C; ++c) {
-                acc0[c] += d0 * xb[c];
-                acc1[c] += d1 * xb[c];
+    // Register blocks of 4 rows x 16 columns (8 vectors of 8 floats: 2 AVX registers or 4 SSE
+    // registers each), summed over the tile's samples in order, then added to G.
+    for (uint32_t r0 = 0; r0 < R; r0 += 4) {
+        for (uint32_t c0 = 0; c0 < C; c0 += 16) {
+            V8 acc[4][2] = {};
+            for (uint32_t b = 0; b < B; ++b) {
+                const V8 x0 = load8(xt + b * C + c0), x1 = load8(xt + b * C + c0 + 8);
+                for (uint32_t k = 0; k < 4; ++k) {
+                    const float d = dzt[b * R + r0 + k];
+                    acc[k][0] += d * x0;
+                    acc[k][1] += d * x1;
+                }
             }
-        }
-        float* __restrict g0 = G + r * C;
-        float* __restrict g1 = G + (r + 1) * C;
-        for (uint32_t c = 0; c < C; ++c) {
-            g0[c] += acc0[c];
-            g1[c] += acc1[c];
+            for (uint32_t k = 0; k < 4; ++k) {
+                float* __restrict gk = G + (r0 + k) * C + c0;
+                store8(gk, load8(gk) + acc[k][0]);
+                store8(gk + 8, load8(gk + 8) + acc[k][1]);
+            }
         }
     }
     for (uint32_t c = 0; c < C; ++c) {
@@ -116,7 +130,7 @@ NB_INLINE void layer_backward(const float* __restrict W, const float* __restrict
     }
 }
 
-NB_CLONES void mlp_forward_kernel(const float* __restrict mlp, BatchTile& t) {
+NBVH_CLONES void mlp_forward_kernel(const float* __restrict mlp, BatchTile& t) {
     layer_forward<kW, kIn, true>(mlp + nb_mlp_layer_offset(0), t.x0, t.h[0]);
     layer_forward<kW, kW, true>(mlp + nb_mlp_layer_offset(1), t.h[0], t.h[1]);
     layer_forward<kW, kW, true>(mlp + nb_mlp_layer_offset(2), t.h[1], t.h[2]);
@@ -126,7 +140,7 @@ NB_CLONES void mlp_forward_kernel(const float* __restrict mlp, BatchTile& t) {
     for (uint32_t i = 0; i < kOut * B; ++i) t.y[i] = nb_sigmoid(t.y[i]);
 }
 
-NB_CLONES void mlp_backward_kernel(const float* __restrict mlp, BatchTile& t, float* __restrict g) {
+NBVH_CLONES void mlp_backward_kernel(const float* __restrict mlp, BatchTile& t, float* __restrict g) {
     // Output layer: dz = dL/dy * y (1 - y); padding rows get no gradient.
     for (uint32_t i = 0; i < kOut * B; ++i) t.dz[i] = t.dy[i] * t.y[i] * (1.0f - t.y[i]);
     layer_backward<kOut, kW, true>(mlp + nb_mlp_layer_offset(4), t.h[3], t.dz, t.xt, t.dzt,
