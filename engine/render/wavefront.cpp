@@ -59,6 +59,9 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
                            (unsigned long long)pixels, (unsigned long long)(range >> 20)));
     uint64_t cap = std::min<uint64_t>(pixels, std::max<uint32_t>(options_.max_wave_pixels, 64));
     cap = std::min<uint64_t>(cap, range / (2ull * NB_RAY_WORDS * 4ull));
+    // Hybrid renders keep a neural state per path and per shadow ray in one binding (neural_stage.h).
+    if (options_.neural.model && !options_.neural.classical)
+        cap = std::min<uint64_t>(cap, range / (2ull * sizeof(GpuNeuralRayState)));
     capacity_ = uint32_t(cap);
 
     features_ = derive_features(scene, environment);

@@ -163,7 +163,11 @@ TEST(HybridRender, TailPassMatchesBatchedRounds) {
 
 TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
     NBVH_REQUIRE_SHARED();
-    const Fixture& f = trained_bunny();
+    Fixture f; // no training needed: validate() reads the scene's neural flags and the model's LoD count
+    SceneLoadOptions lo;
+    lo.neural_glob = "*";
+    f.scene = load_gltf(test::scenes_dir() / "stanford_bunny" / "stanford_bunny.glb", lo);
+    f.model.lod_count = 2;
     NeuralRenderOptions o;
     o.model = &f.model;
     o.lod = 7;
