@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
+#include <vector>
 
 #include "engine/core/error.h"
 
@@ -36,7 +38,8 @@ inline void adam_update(float& w, float g, float& m, float& v, uint32_t& t, floa
 }
 } // namespace
 
-void Adam::step(NetworkWeights& w, const std::vector<float>& mlp_grad, const std::vector<float>& grid_grad) {
+void Adam::step(NetworkWeights& w, const std::vector<float>& mlp_grad, const std::vector<float>& grid_grad,
+                unsigned threads) {
     NBVH_CHECK(w.mlp.size() == mlp_m_.size() && mlp_grad.size() == mlp_m_.size());
     NBVH_CHECK(w.grid.size() == grid_m_.size() && grid_grad.size() == grid_m_.size());
     const float lr = lr_at_step(cfg_, steps_);
@@ -50,11 +53,23 @@ void Adam::step(NetworkWeights& w, const std::vector<float>& mlp_grad, const std
     for (size_t i = 0; i < w.mlp.size(); ++i)
         adam_update(w.mlp[i], mlp_grad[i] * inv_scale, mlp_m_[i], mlp_v_[i], mlp_t_[i], cfg_.l2_reg, lr, cfg_, bias_sqrt_,
                     bias_div_);
-    for (size_t i = 0; i < w.grid.size(); ++i) {
-        const float g = grid_grad[i] * inv_scale;
-        if (g == 0.0f && cfg_.skip_zero_grad_non_matrix) continue;
-        adam_update(w.grid[i], g, grid_m_[i], grid_v_[i], grid_t_[i], cfg_.non_matrix_l2_reg, lr, cfg_, bias_sqrt_,
-                    bias_div_);
+    auto grid_slice = [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) {
+            const float g = grid_grad[i] * inv_scale;
+            if (g == 0.0f && cfg_.skip_zero_grad_non_matrix) continue;
+            adam_update(w.grid[i], g, grid_m_[i], grid_v_[i], grid_t_[i], cfg_.non_matrix_l2_reg, lr, cfg_,
+                        bias_sqrt_, bias_div_);
+        }
+    };
+    const size_t n = w.grid.size();
+    threads = unsigned(std::clamp<size_t>(threads, 1, std::max<size_t>(1, n / 65536)));
+    if (threads == 1) {
+        grid_slice(0, n);
+    } else {
+        std::vector<std::thread> pool;
+        for (unsigned t = 1; t < threads; ++t) pool.emplace_back(grid_slice, n * t / threads, n * (t + 1) / threads);
+        grid_slice(0, n / threads);
+        for (std::thread& th : pool) th.join();
     }
     ++steps_;
 }

@@ -41,7 +41,10 @@ class Adam {
 public:
     Adam(const AdamConfig& cfg, size_t mlp_params, size_t grid_params);
     // One step on w (fp32 master) with dense gradients of the same sizes as w.mlp / w.grid.
-    void step(NetworkWeights& w, const std::vector<float>& mlp_grad, const std::vector<float>& grid_grad);
+    // `threads` > 1 splits the grid update into contiguous slices (per-parameter independent, so the
+    // result is identical for any thread count).
+    void step(NetworkWeights& w, const std::vector<float>& mlp_grad, const std::vector<float>& grid_grad,
+              unsigned threads = 1);
     uint64_t steps_taken() const { return steps_; }
     const AdamConfig& config() const { return cfg_; }
     // State, exposed for tests and checkpoints: moments and per-parameter step counters.

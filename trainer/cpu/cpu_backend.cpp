@@ -49,6 +49,19 @@ TrainingSample draw_training_sample(const TrainingAsset& asset, std::span<const 
 
 namespace {
 
+// fn(t) for t in [0, n) on n threads (t = 0 on the calling thread).
+template <class F>
+void run_on_threads(unsigned n, F&& fn) {
+    if (n == 1) {
+        fn(0u);
+        return;
+    }
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < n; ++t) pool.emplace_back([&fn, t] { fn(t); });
+    fn(0u);
+    for (std::thread& th : pool) th.join();
+}
+
 bool all_finite(const float* v, size_t n) {
     // Sum of (x * 0) is NaN iff some x is NaN or Inf; cheaper than a branch per value.
     float acc = 0.0f;
@@ -138,14 +151,7 @@ public:
                 neural::backward_tile(weights_, tile, ts.grads.mlp.data(), sink);
             }
         };
-        if (n_threads == 1) {
-            work(0);
-        } else {
-            std::vector<std::thread> pool;
-            for (unsigned t = 1; t < n_threads; ++t) pool.emplace_back(work, t);
-            work(0);
-            for (std::thread& th : pool) th.join();
-        }
+        run_on_threads(n_threads, work);
 
         // Reduce.
         StepStats st;
@@ -171,10 +177,19 @@ public:
                 st.leaves[i].draws += ts.leaf_draws[i];
             }
             for (size_t i = 0; i < mlp_grad_.size(); ++i) mlp_grad_[i] += ts.grads.mlp[i];
-            if (dense_grid_)
-                for (size_t i = 0; i < grid_grad_.size(); ++i) grid_grad_[i] += ts.grid_grad[i];
-            else
+            if (!dense_grid_)
                 for (const neural::GridGrad<float>& g : ts.grid_sparse) grid_grad_[g.index] += g.grad;
+        }
+        if (dense_grid_) {
+            // Dense grid gradients: reduced in slices on all threads (thread order per value, as serial).
+            auto reduce = [&](unsigned s) {
+                const size_t n = grid_grad_.size(), b = n * s / n_threads, e = n * (s + 1) / n_threads;
+                for (unsigned t = 0; t < n_threads; ++t) {
+                    const float* src = per_thread_[t].grid_grad.data();
+                    for (size_t i = b; i < e; ++i) grid_grad_[i] += src[i];
+                }
+            };
+            run_on_threads(n_threads, reduce);
         }
         if (st.samples == 0) {
             st.skipped = true;
@@ -203,7 +218,7 @@ public:
             st.skip_reason = "non-finite gradient";
             return st;
         }
-        adam_.step(weights_, mlp_grad_, grid_grad_);
+        adam_.step(weights_, mlp_grad_, grid_grad_, threads_);
         return st;
     }
 
