@@ -73,6 +73,17 @@ std::vector<uint32_t> pack_halves(const std::vector<uint16_t>& halves) {
     return words;
 }
 
+std::vector<uint16_t> transpose_mlp(const std::vector<uint16_t>& mlp) {
+    NBVH_CHECK(mlp.size() == NB_MLP_WEIGHT_COUNT);
+    std::vector<uint16_t> t(mlp.size());
+    for (uint32_t m = 0; m < NB_MLP_MATRICES; ++m) {
+        const uint32_t ins = nb_mlp_layer_inputs(m), outs = nb_mlp_layer_outputs(m), off = nb_mlp_layer_offset(m);
+        for (uint32_t r = 0; r < outs; ++r)
+            for (uint32_t c = 0; c < ins; ++c) t[off + c * outs + r] = mlp[nb_mlp_weight_index(m, r, c)];
+    }
+    return t;
+}
+
 GpuEncodingBox encoding_box_of(const NeuralModel& model) {
     return nb_make_encoding_box(model.encoding_box.lo, model.encoding_box.hi);
 }
@@ -105,6 +116,7 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
     levels_ = vk::make_buffer(ctx, model.levels, "neural levels");
     grid_ = vk::make_buffer(ctx, pack_halves(model.grid), "neural grid");
     mlp_ = vk::make_buffer(ctx, pack_halves(model.mlp), "neural mlp");
+    mlp_t_ = vk::make_buffer(ctx, pack_halves(transpose_mlp(model.mlp)), "neural mlp transposed");
     std::vector<GpuBvhNode> nodes;
     pack_lod_nodes(model, nodes, roots_);
     nodes_ = vk::make_buffer(ctx, nodes, "nbvh nodes");
@@ -116,7 +128,7 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
     }
     leaf_bounds_ = vk::make_buffer(ctx, bounds, "nbvh node bounds");
     box_ = encoding_box_of(model);
-    bytes_ = levels_.size() + grid_.size() + mlp_.size() + nodes_.size() + leaf_bounds_.size();
+    bytes_ = levels_.size() + grid_.size() + mlp_.size() + mlp_t_.size() + nodes_.size() + leaf_bounds_.size();
 }
 
 uint32_t NeuralModelGpu::lod_root(uint32_t lod) const {
@@ -131,12 +143,14 @@ const char* eval_shader(const NeuralKernelChoice& c) {
 }
 } // namespace
 
-NeuralEvaluator::NeuralEvaluator(const vk::Context& ctx, const NeuralModelGpu& model, NeuralKernelChoice choice)
+NeuralEvaluator::NeuralEvaluator(const vk::Context& ctx, const NeuralModelGpu& model, NeuralKernelChoice choice,
+                                 uint32_t part)
     : ctx_(ctx), model_(model), choice_(choice) {
     vk::PipelineDesc desc;
     desc.shader = eval_shader(choice_);
     for (uint32_t b = 0; b <= NB_NEVAL_BIND_HITS; ++b) desc.bindings.push_back({b, vk::BindingType::storage_buffer, 1});
     desc.push_constant_bytes = sizeof(GpuNeuralEvalPush);
+    if (choice_.path == NeuralPath::coopmat) desc.spec = {{0, part}};
     pipeline_ = vk::ComputePipeline(ctx_, desc);
 }
 
@@ -164,7 +178,7 @@ double NeuralEvaluator::time_dispatch(uint32_t count, int repetitions, float thr
     vk::DescriptorSet set(ctx_, pipeline_);
     set.bind(NB_NEVAL_BIND_LEVELS, model_.levels())
         .bind(NB_NEVAL_BIND_GRID, model_.grid())
-        .bind(NB_NEVAL_BIND_MLP, model_.mlp())
+        .bind(NB_NEVAL_BIND_MLP, choice_.path == NeuralPath::coopmat ? model_.mlp_transposed() : model_.mlp())
         .bind(NB_NEVAL_BIND_QUERIES, queries_)
         .bind(NB_NEVAL_BIND_HITS, hits_);
     GpuNeuralEvalPush push{};

@@ -43,6 +43,9 @@ GpuEncodingBox encoding_box_of(const NeuralModel& model);
 // Nodes of every LoD concatenated; roots[l] = first node of LoD l. Interior refs are offset so each
 // LoD's nodes index the concatenated array; leaf refs keep N-BVH node indices.
 void pack_lod_nodes(const NeuralModel& model, std::vector<GpuBvhNode>& nodes, std::vector<uint32_t>& roots);
+// The weights with every matrix transposed (row-major inputs x outputs, same offsets as mlp.h): the
+// cooperative-matrix kernels load B = W^T tiles as contiguous rows.
+std::vector<uint16_t> transpose_mlp(const std::vector<uint16_t>& mlp);
 
 class NeuralModelGpu {
 public:
@@ -53,6 +56,7 @@ public:
     const vk::Buffer& levels() const { return levels_; }
     const vk::Buffer& grid() const { return grid_; }
     const vk::Buffer& mlp() const { return mlp_; }
+    const vk::Buffer& mlp_transposed() const { return mlp_t_; } // cooperative-matrix kernels
     const vk::Buffer& nodes() const { return nodes_; }      // GpuBvhNode, all LoDs
     const vk::Buffer& leaf_bounds() const { return leaf_bounds_; } // vec3 lo, vec3 hi per N-BVH node
     const GpuEncodingBox& box() const { return box_; }
@@ -60,16 +64,18 @@ public:
     uint32_t lod_root(uint32_t lod) const; // clamps lod to the coarsest
     uint64_t bytes() const { return bytes_; }
     // Hands the buffers to a renderer that binds them by slot (this object keeps box and roots).
-    void move_into(vk::Buffer& levels, vk::Buffer& grid, vk::Buffer& mlp, vk::Buffer& nodes, vk::Buffer& bounds) {
+    void move_into(vk::Buffer& levels, vk::Buffer& grid, vk::Buffer& mlp, vk::Buffer& mlp_t, vk::Buffer& nodes,
+                   vk::Buffer& bounds) {
         levels = std::move(levels_);
         grid = std::move(grid_);
         mlp = std::move(mlp_);
+        mlp_t = std::move(mlp_t_);
         nodes = std::move(nodes_);
         bounds = std::move(leaf_bounds_);
     }
 
 private:
-    vk::Buffer levels_, grid_, mlp_, nodes_, leaf_bounds_;
+    vk::Buffer levels_, grid_, mlp_, mlp_t_, nodes_, leaf_bounds_;
     GpuEncodingBox box_{};
     std::vector<uint32_t> roots_;
     uint64_t bytes_ = 0;
@@ -78,7 +84,8 @@ private:
 // Runs the flat-list query kernels.
 class NeuralEvaluator {
 public:
-    NeuralEvaluator(const vk::Context& ctx, const NeuralModelGpu& model, NeuralKernelChoice choice);
+    // part (cooperative-matrix kernels only, benchmark breakdown): 0 full, 1 features only, 2 MLP only.
+    NeuralEvaluator(const vk::Context& ctx, const NeuralModelGpu& model, NeuralKernelChoice choice, uint32_t part = 0);
     const NeuralKernelChoice& choice() const { return choice_; }
 
     // Decoded hits of `queries` (object space, this model's encoding box).

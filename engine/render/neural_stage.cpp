@@ -87,7 +87,7 @@ const char* NeuralStage::query_shader() const {
 void NeuralStage::install(std::vector<vk::Buffer>& buffers) {
     if (buffers.size() < NB_NEURAL_BINDING_END) buffers.resize(NB_NEURAL_BINDING_END);
     model_.move_into(buffers[NB_BIND_NEURAL_LEVELS], buffers[NB_BIND_NEURAL_GRID], buffers[NB_BIND_NEURAL_MLP],
-                     buffers[NB_BIND_NBVH_NODES], buffers[NB_BIND_NBVH_BOUNDS]);
+                     buffers[NB_BIND_NEURAL_MLP_T], buffers[NB_BIND_NBVH_NODES], buffers[NB_BIND_NBVH_BOUNDS]);
     // Two halves (ping-pong between a query round and the traversal that follows it).
     buffers[NB_BIND_PENDING_LEAVES] = vk::Buffer(ctx_, 2ull * std::max(capacity_, 1u) * sizeof(GpuPendingLeaf),
                                                  vk::MemoryKind::device, 0, "pending leaves");

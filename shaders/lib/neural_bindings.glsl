@@ -1,7 +1,7 @@
 // Set-0 bindings of the neural part of the wavefront renderer (shared/neural_gpu.h NB_BIND_NEURAL_*),
 // included after lib/bindings.glsl by every pass that touches neural data. The weight buffer is seen as
 // packed fp16 pairs (uint) unless the pass defines NB_NEURAL_MLP_AS_HALF before including this (the
-// cooperative-matrix query pass, which reads it as float16_t).
+// cooperative-matrix query pass, which reads the transposed copy, NB_BIND_NEURAL_MLP_T, as float16_t).
 #ifndef NB_NEURAL_BINDINGS_GLSL
 #define NB_NEURAL_BINDINGS_GLSL
 #include "shared/hashgrid.h"
@@ -12,7 +12,7 @@ layout(set = 0, binding = NB_BIND_NEURAL_GRID, scalar) readonly buffer NeuralGri
 #ifdef NB_NEURAL_MLP_AS_HALF
 #extension GL_EXT_shader_16bit_storage : require
 #extension GL_EXT_shader_explicit_arithmetic_types_float16 : require
-layout(set = 0, binding = NB_BIND_NEURAL_MLP, scalar) readonly buffer NeuralMlpBuffer { float16_t neural_mlp_h[]; };
+layout(set = 0, binding = NB_BIND_NEURAL_MLP_T, scalar) readonly buffer NeuralMlpBuffer { float16_t neural_mlp_h[]; };
 #else
 layout(set = 0, binding = NB_BIND_NEURAL_MLP, scalar) readonly buffer NeuralMlpBuffer { uint neural_mlp[]; };
 #endif

@@ -8,6 +8,11 @@ layout(set = 0, binding = NB_NEVAL_BIND_MLP, scalar) readonly buffer MlpBuffer {
 
 layout(local_size_x = NB_NEURAL_GROUP) in;
 
+// Benchmark breakdown (NeuralEvaluator::set_part): 0 = full query, 1 = hash-grid features only (the MLP
+// skipped, outputs read straight from the staged features), 2 = MLP only (features are a cheap function
+// of the query index instead of grid lookups). Results of parts 1 and 2 are meaningless by design.
+layout(constant_id = 0) const uint NB_EVAL_PART = 0u;
+
 void main() {
     uint i = gl_GlobalInvocationID.x;
     uint local = gl_LocalInvocationID.x;
@@ -20,11 +25,20 @@ void main() {
     if (valid) q = queries[i];
     vec3 p0, p1, p2;
     nb_segment_points(pc.box, q.origin, q.dir, q.t_entry, q.t_exit, p0, p1, p2);
-    nb_coop_stage_features(local, valid, p0, p1, p2);
+    if (NB_EVAL_PART == 2u) {
+        for (uint f = 0u; f < NB_MLP_INPUTS; ++f)
+            nb_sh_x[local * NB_COOP_STRIDE + f] = float16_t(float((i * 7u + f) & 15u) * (1.0f / 16.0f) + p0.x);
+    } else {
+        nb_coop_stage_features(local, valid, p0, p1, p2);
+    }
     barrier();
-    nb_mlp_forward_coopmat(); // whole workgroup, uniform control flow
+    if (NB_EVAL_PART != 1u) nb_mlp_forward_coopmat(); // whole workgroup, uniform control flow
     if (!valid) return;
     float y[NB_MLP_OUTPUTS];
-    for (uint r = 0u; r < NB_MLP_OUTPUTS; ++r) y[r] = nb_sigmoid(nb_sh_y[local * NB_MLP_OUTPUTS_PADDED + r]);
+    for (uint r = 0u; r < NB_MLP_OUTPUTS; ++r) {
+        float pre = NB_EVAL_PART == 1u ? float(nb_sh_x[local * NB_COOP_STRIDE + r * 12u])
+                                       : nb_sh_y[local * NB_MLP_OUTPUTS_PADDED + r];
+        y[r] = nb_sigmoid(pre);
+    }
     hits[i] = nb_neural_decode(pc.box, y, q.t_entry, q.t_exit, pc.threshold);
 }

@@ -2,7 +2,8 @@
 // of NB_NEURAL_GROUP (64) invocations = 2 subgroups of 32 evaluates 64 queries; each subgroup owns 32
 // rows (queries) of the activation matrices. Features and activations stay in shared memory
 // (on chip) between layers; weights are read as 16x16 fp16 tiles straight from the storage buffer
-// (38 KiB, L1/L2 resident), each B tile once per subgroup and layer.
+// (38 KiB, L1/L2 resident), each B tile once per subgroup and layer, from a copy with every matrix
+// transposed (engine/render/neural_model_gpu.h transpose_mlp) so B = W^T tiles are contiguous rows.
 // Per layer: H_out(32 x 64) = relu(H_in(32 x K) * W^T(K x 64)), K = 96 or 64,
 // 16x16x16 tiles, accumulators fp32 (NB_COOP_ACC_BITS 32, rounding points of mlp.h R3/R4 with a
 // different summation order) or fp16 (16, for devices without fp32 accumulation).
@@ -10,7 +11,7 @@
 //
 // Only compiled into passes that are created on devices with VK_NV_cooperative_matrix, 16x16x16 fp16
 // shapes and subgroup size 32 (engine/render/neural_model_gpu.cpp checks). The including shader
-// declares `float16_t neural_mlp_h[];` (the weight buffer seen as halves), defines NB_COOP_ACC_BITS,
+// declares `float16_t neural_mlp_h[];` (the TRANSPOSED weight buffer seen as halves), defines NB_COOP_ACC_BITS,
 // fills nb_sh_x (query row r at r*96, features in mlp.h input order) and calls
 // nb_mlp_forward_coopmat() from uniform control flow; outputs (after the sigmoid) are then in
 // nb_sh_y[r*16 + 0..7].
@@ -52,7 +53,7 @@ shared float nb_sh_y[NB_NEURAL_GROUP * NB_MLP_OUTPUTS_PADDED];
             coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE + kt * 16u, NB_COOP_STRIDE, false); \
             for (uint nt = 0u; nt < 4u; ++nt) {                                                       \
                 NB_FCM(16) b;                                                                         \
-                coopMatLoadNV(b, neural_mlp_h, nb_mlp_layer_offset(M) + nt * 16u * (K) + kt * 16u, (K), true); \
+                coopMatLoadNV(b, neural_mlp_h, nb_mlp_layer_offset(M) + kt * 16u * NB_MLP_WIDTH + nt * 16u, NB_MLP_WIDTH, false); \
                 acc[nt] = coopMatMulAddNV(a0, b, acc[nt]);                                            \
                 acc[4u + nt] = coopMatMulAddNV(a1, b, acc[4u + nt]);                                  \
             }                                                                                         \
@@ -79,7 +80,8 @@ void nb_mlp_forward_coopmat() {
         NB_FCM(NB_COOP_ACC_BITS) acc1 = acc0;
         for (uint kt = 0u; kt < NB_MLP_WIDTH / 16u; ++kt) {
             NB_FCM(16) b;
-            coopMatLoadNV(b, neural_mlp_h, nb_mlp_layer_offset(NB_MLP_HIDDEN_LAYERS) + kt * 16u, NB_MLP_WIDTH, true);
+            coopMatLoadNV(b, neural_mlp_h, nb_mlp_layer_offset(NB_MLP_HIDDEN_LAYERS) + kt * 16u * NB_MLP_OUTPUTS_PADDED,
+                          NB_MLP_OUTPUTS_PADDED, false);
             NB_FCM(16) a0;
             NB_FCM(16) a1;
             coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE + kt * 16u, NB_COOP_STRIDE, false);

@@ -55,7 +55,7 @@ NB_STATIC_ASSERT(sizeof(GpuNeuralEvalPush) == 48, "GpuNeuralEvalPush layout");
 // Bindings of the eval kernels (set 0).
 #define NB_NEVAL_BIND_LEVELS 0u   // GpuHashLevel[NB_GRID_MAX_LEVELS]
 #define NB_NEVAL_BIND_GRID 1u     // uint[]: fp16 pairs, entry e = words 2e, 2e+1 (features 0..3)
-#define NB_NEVAL_BIND_MLP 2u      // uint[]: fp16 pairs, NB_MLP_WEIGHT_COUNT / 2 words
+#define NB_NEVAL_BIND_MLP 2u      // uint[]: fp16 pairs, NB_MLP_WEIGHT_COUNT / 2 words (coopmat: transposed)
 #define NB_NEVAL_BIND_QUERIES 3u  // GpuNeuralQuery[]
 #define NB_NEVAL_BIND_HITS 4u     // GpuNeuralHit[]
 
@@ -131,6 +131,7 @@ NB_STATIC_ASSERT(sizeof(GpuNeuralCounters) == 16, "GpuNeuralCounters layout");
 #define NB_BIND_NEURAL_STATE 25u
 #define NB_BIND_NEURAL_PARAMS 26u
 #define NB_BIND_NEURAL_COUNTERS 27u
-#define NB_NEURAL_BINDING_END 28u
+#define NB_BIND_NEURAL_MLP_T 28u    // the weights with each matrix transposed (cooperative-matrix pass)
+#define NB_NEURAL_BINDING_END 29u
 
 #endif

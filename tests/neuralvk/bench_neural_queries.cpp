@@ -128,6 +128,18 @@ int main(int argc, char** argv) try {
         std::printf("%-70s %9.3f ms / %zu queries = %.3f G queries/s\n", r.path.c_str(), r.ms, qs.size(), r.qps * 1e-9);
         rows.push_back(std::move(r));
     }
+    // Where the cooperative-matrix query's time goes: features only, MLP only.
+    double ms_features = 0, ms_mlp = 0;
+    if (why.empty()) {
+        NeuralEvaluator fe(ctx, gpu, choose_neural_kernel(dev, NeuralPath::coopmat), 1);
+        fe.evaluate(qs);
+        ms_features = fe.time_dispatch(uint32_t(qs.size()), reps);
+        NeuralEvaluator me(ctx, gpu, choose_neural_kernel(dev, NeuralPath::coopmat), 2);
+        me.evaluate(qs);
+        ms_mlp = me.time_dispatch(uint32_t(qs.size()), reps);
+        std::printf("coopmat breakdown: hash-grid features only %.3f ms (%.3f G/s), MLP only %.3f ms (%.3f G/s)\n",
+                    ms_features, qs.size() / (ms_features * 1e6), ms_mlp, qs.size() / (ms_mlp * 1e6));
+    }
     std::string agree = "{}";
     if (rows.size() == 2) {
         double max_dy = 0, sum_dy = 0;
@@ -164,7 +176,8 @@ int main(int argc, char** argv) try {
         for (size_t i = 0; i < rows.size(); ++i)
             f << (i ? ", " : "") << "{\"path\": \"" << rows[i].path << "\", \"ms\": " << rows[i].ms
               << ", \"queries_per_s\": " << rows[i].qps << "}";
-        f << "],\n  \"scalar_vs_coopmat\": " << agree << "\n}\n";
+        f << "],\n  \"coopmat_features_only_ms\": " << ms_features << ",\n  \"coopmat_mlp_only_ms\": " << ms_mlp
+          << ",\n  \"scalar_vs_coopmat\": " << agree << "\n}\n";
     }
     return 0;
 } catch (const std::exception& e) {

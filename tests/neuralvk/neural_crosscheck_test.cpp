@@ -131,3 +131,13 @@ TEST(NeuralCrossCheck, ScalarKernelMatchesFp16Reference) {
     EXPECT_GT(reversed, int(qs.size() / 8));
     EXPECT_EQ(ctx.validation_message_count(), 0);
 }
+
+TEST(NeuralPath, TransposedWeightsForCooperativeMatrices) {
+    std::vector<uint16_t> w(NB_MLP_WEIGHT_COUNT);
+    for (size_t i = 0; i < w.size(); ++i) w[i] = uint16_t(i * 2654435761u >> 16);
+    const std::vector<uint16_t> t = transpose_mlp(w);
+    for (uint32_t m = 0; m < NB_MLP_MATRICES; ++m)
+        for (uint32_t r : {0u, 5u, nb_mlp_layer_outputs(m) - 1u})
+            for (uint32_t c : {0u, 17u, nb_mlp_layer_inputs(m) - 1u})
+                EXPECT_EQ(t[nb_mlp_layer_offset(m) + c * nb_mlp_layer_outputs(m) + r], w[nb_mlp_weight_index(m, r, c)]);
+}
