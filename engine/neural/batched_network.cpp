@@ -8,7 +8,7 @@
 
 // Two code paths of the MLP kernels chosen at load time (ifunc): x86-64-v3 (AVX2 + FMA) and the
 // build's baseline. Portable: other compilers/targets get the baseline only.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(NBVH_NO_TARGET_CLONES)
 #define NBVH_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else
 #define NBVH_CLONES
@@ -85,7 +85,7 @@ NBVH_ALWAYS_INLINE V8 load8(const float* p) {
     std::memcpy(&v, p, sizeof(v));
     return v;
 }
-NBVH_ALWAYS_INLINE void store8(float* p, V8 v) { std::memcpy(p, &v, sizeof(v)); }
+NBVH_ALWAYS_INLINE void store8(float* p, const V8& v) { std::memcpy(p, &v, sizeof(v)); }
 
 // One matrix backward. dz: [R][B] dL/d(pre-activation). Adds dL/dW = sum_b dz[r][b] X[c][b] to G
 // (tile partial sums over the samples in order) and writes
