@@ -17,6 +17,7 @@
 
 #include "app/commands.h"
 #include "app/output_path.h"
+#include "app/render_args.h"
 #include "app/scene_arg.h"
 #include "engine/bvh/scene_accel.h"
 #include "engine/core/error.h"
@@ -37,19 +38,6 @@ struct RenderArgs {
     render::RenderOptions options;
     bool explain = false;
 };
-
-// The environment to light with: --env, else the scene's, else the default sky when nothing else
-// would light the scene (a glTF without lights would otherwise render black).
-Environment choose_environment(const Scene& scene, const std::string& env_path) {
-    if (!env_path.empty()) return load_environment(env_path);
-    if (!scene.environment.empty()) return scene.environment;
-    const render::SceneFeatures f = render::derive_features(scene, Environment{});
-    if (!f.emission) {
-        log_info("render: the scene has no lights; lighting it with the default sky (use --env to change)");
-        return default_sky();
-    }
-    return Environment{};
-}
 
 void write_stats(const std::string& path, const render::RenderStats& s, const std::string& scene) {
     nlohmann::json j;
@@ -104,9 +92,7 @@ void run_render(const RenderArgs& a) {
     }
     options.neural.path = render::parse_neural_path(a.neural_path);
     const Environment env = choose_environment(scene, a.env);
-    const float aspect = float(a.options.width) / float(std::max(1u, a.options.height));
-    const Camera camera = !a.camera.empty() ? parse_camera(a.camera) : scene.has_camera ? scene.camera
-                                                                                         : auto_frame(scene, aspect);
+    const Camera camera = choose_camera(scene, a.camera, a.options);
     if (a.explain) {
         std::printf("%s", render::explain(render::derive_features(scene, env), a.options.max_depth).c_str());
         return;
@@ -144,12 +130,7 @@ void add_render_command(CLI::App& app) {
     auto* cmd = app.add_subcommand("render", "path-trace a glTF scene (or 'default') with the wavefront renderer");
     cmd->add_option("scene", args->scene, "glTF/GLB file, or 'default' for the built-in scene")->required();
     cmd->add_option("--out", args->out, "output image: .png (tone-mapped sRGB) or .exr (linear)");
-    cmd->add_option("--width", args->options.width, "image width in pixels")->check(CLI::Range(1u, 16384u));
-    cmd->add_option("--height", args->options.height, "image height in pixels")->check(CLI::Range(1u, 16384u));
-    cmd->add_option("--spp", args->options.spp, "samples per pixel")->check(CLI::Range(1u, 1u << 20));
-    cmd->add_option("--max-depth", args->options.max_depth, "maximum path segments (1 = direct visibility)")
-        ->check(CLI::Range(1u, 256u));
-    cmd->add_option("--seed", args->options.seed, "random seed");
+    add_render_option_flags(cmd, args->options); // --width --height --spp --max-depth --seed, neural constants
     cmd->add_option("--device", args->device, "Vulkan device: auto, gpu or cpu (lavapipe)");
     cmd->add_option("--camera", args->camera, "eye_x,eye_y,eye_z,target_x,target_y,target_z,fov_deg");
     cmd->add_option("--env", args->env, "environment map (.hdr or .exr, equirectangular)");
@@ -163,15 +144,6 @@ void add_render_command(CLI::App& app) {
     cmd->add_option("--secondary-lod", args->options.neural.secondary_lod,
                     "N-BVH level of detail after the first hit (default: --lod)");
     cmd->add_option("--neural-path", args->neural_path, "MLP implementation: auto, scalar or coopmat");
-    cmd->add_option("--neural-roughness", args->options.neural.roughness, "roughness of neural surfaces [0,1]");
-    cmd->add_option("--neural-metallic", args->options.neural.metallic, "metallic of neural surfaces [0,1]");
-    cmd->add_option("--neural-max-leaves", args->options.neural.max_rounds,
-                    "neural leaves queried per ray at most (then the closest hit so far is kept)");
-    cmd->add_option("--neural-batched-rounds", args->options.neural.batched_rounds,
-                    "leaf rounds through the batched query pass before the per-ray tail pass");
-    cmd->add_option("--wave-pixels", args->options.max_wave_pixels,
-                    "pixels traced per wave (rays per queue; clamped by the device's storage-buffer range)")
-        ->check(CLI::Range(64u, 1u << 26));
     cmd->callback([args] { run_render(*args); });
 }
 

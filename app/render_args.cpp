@@ -1,0 +1,46 @@
+#include "app/render_args.h"
+
+#include <algorithm>
+
+#include "engine/core/log.h"
+#include "engine/scene/camera.h"
+#include "engine/scene/environment.h"
+
+namespace nbvh::app {
+
+void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
+    cmd->add_option("--width", o.width, "image width in pixels")->check(CLI::Range(1u, 16384u));
+    cmd->add_option("--height", o.height, "image height in pixels")->check(CLI::Range(1u, 16384u));
+    cmd->add_option("--spp", o.spp, "samples per pixel")->check(CLI::Range(1u, 1u << 20));
+    cmd->add_option("--max-depth", o.max_depth, "maximum path segments (1 = direct visibility)")
+        ->check(CLI::Range(1u, 256u));
+    cmd->add_option("--seed", o.seed, "random seed");
+    cmd->add_option("--neural-roughness", o.neural.roughness, "roughness of neural surfaces [0,1]");
+    cmd->add_option("--neural-metallic", o.neural.metallic, "metallic of neural surfaces [0,1]");
+    cmd->add_option("--neural-max-leaves", o.neural.max_rounds,
+                    "neural leaves queried per ray at most (then the closest hit so far is kept)");
+    cmd->add_option("--neural-batched-rounds", o.neural.batched_rounds,
+                    "leaf rounds through the batched query pass before the per-ray tail pass");
+    cmd->add_option("--wave-pixels", o.max_wave_pixels,
+                    "pixels traced per wave (rays per queue; clamped by the device's storage-buffer range)")
+        ->check(CLI::Range(64u, 1u << 26));
+}
+
+Environment choose_environment(const Scene& scene, const std::string& env_path) {
+    if (!env_path.empty()) return load_environment(env_path);
+    if (!scene.environment.empty()) return scene.environment;
+    const render::SceneFeatures f = render::derive_features(scene, Environment{});
+    if (!f.emission) {
+        log_info("render: the scene has no lights; lighting it with the default sky (use --env to change)");
+        return default_sky();
+    }
+    return Environment{};
+}
+
+Camera choose_camera(const Scene& scene, const std::string& camera_arg, const render::RenderOptions& o) {
+    const float aspect = float(o.width) / float(std::max(1u, o.height));
+    if (!camera_arg.empty()) return parse_camera(camera_arg);
+    return scene.has_camera ? scene.camera : auto_frame(scene, aspect);
+}
+
+} // namespace nbvh::app

@@ -1,0 +1,26 @@
+// Render options shared by the subcommands that render (nbvh render, nbvh bench): the CLI flags that
+// fill render::RenderOptions, and the environment and camera a render of a scene uses when none is given.
+#pragma once
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "engine/render/wavefront.h"
+#include "engine/scene/scene.h"
+
+namespace nbvh::app {
+
+// Adds --width --height --spp --max-depth --seed --wave-pixels and the neural material/round flags
+// (--neural-roughness --neural-metallic --neural-max-leaves --neural-batched-rounds), writing into `o`
+// (which must outlive the parse).
+void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o);
+
+// The environment to light with: `env_path` (--env), else the scene's, else the default sky when nothing
+// else would light the scene (a glTF without lights would otherwise render black).
+Environment choose_environment(const Scene& scene, const std::string& env_path);
+
+// The view: `camera_arg` (--camera ex,ey,ez,tx,ty,tz,fov), else the scene's, else auto-framed for the
+// image aspect of `o`.
+Camera choose_camera(const Scene& scene, const std::string& camera_arg, const render::RenderOptions& o);
+
+} // namespace nbvh::app
