@@ -1,6 +1,7 @@
 #include "engine/render/neural_model_gpu.h"
 
 #include <algorithm>
+#include <cstdlib>
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
@@ -136,10 +137,19 @@ uint32_t NeuralModelGpu::lod_root(uint32_t lod) const {
     return roots_[std::min<size_t>(lod, roots_.size() - 1)];
 }
 
+const char* coopmat_fp32_shader(const char* kind) {
+    const char* v = std::getenv("NBVH_NEURAL_COOP_VARIANT");
+    const std::string variant = v ? v : "";
+    const bool eval = std::string(kind) == "eval";
+    if (variant == "base") return eval ? "passes/neural_eval_coop32.comp" : "passes/neural_query_coop32.comp";
+    if (variant == "w") return eval ? "passes/neural_eval_coop32w.comp" : "passes/neural_query_coop32w.comp";
+    return eval ? "passes/neural_eval_coop32f.comp" : "passes/neural_query_coop32f.comp"; // "f", the default
+}
+
 namespace {
 const char* eval_shader(const NeuralKernelChoice& c) {
     if (c.path == NeuralPath::scalar) return "passes/neural_eval_scalar.comp";
-    return c.fp32_accumulate ? "passes/neural_eval_coop32.comp" : "passes/neural_eval_coop16.comp";
+    return c.fp32_accumulate ? coopmat_fp32_shader("eval") : "passes/neural_eval_coop16.comp";
 }
 } // namespace
 

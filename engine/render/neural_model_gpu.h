@@ -37,6 +37,11 @@ NeuralKernelChoice choose_neural_kernel(const vk::DeviceFeatures& dev, NeuralPat
 // Why the cooperative-matrix path is unavailable ("" when it is available).
 std::string coopmat_unavailable_reason(const vk::DeviceFeatures& dev);
 
+// Shader of the fp32-accumulating cooperative-matrix kernel: kind "eval" or "query". The environment
+// variable NBVH_NEURAL_COOP_VARIANT (benchmarking only) picks a variant: "f" (default: unrolled, subgroup
+// barriers), "base" (the v5-v7 kernel) or "w" (f + hidden weights in shared memory; 5x slower on the H200).
+const char* coopmat_fp32_shader(const char* kind);
+
 // Host-side packing (pure CPU, unit-testable).
 std::vector<uint32_t> pack_halves(const std::vector<uint16_t>& halves); // pairs -> words (low = even)
 GpuEncodingBox encoding_box_of(const NeuralModel& model);

@@ -81,7 +81,7 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
 
 const char* NeuralStage::query_shader() const {
     if (kernel_.path == NeuralPath::scalar) return "passes/neural_query_scalar.comp";
-    return kernel_.fp32_accumulate ? "passes/neural_query_coop32.comp" : "passes/neural_query_coop16.comp";
+    return kernel_.fp32_accumulate ? coopmat_fp32_shader("query") : "passes/neural_query_coop16.comp";
 }
 
 void NeuralStage::install(std::vector<vk::Buffer>& buffers) {

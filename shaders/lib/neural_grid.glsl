@@ -12,6 +12,14 @@
 #include "shared/neural_query.h"
 #include "shared/neural_gpu.h"
 
+// The cooperative-matrix kernels with NB_COOP_FAST unroll the corner loop (8 independent loads in flight).
+#if defined(NB_COOP_FAST) && NB_COOP_FAST
+#extension GL_EXT_control_flow_attributes : require
+#define NB_GRID_UNROLL [[unroll]]
+#else
+#define NB_GRID_UNROLL
+#endif
+
 // Round to the nearest fp16 value (round to nearest even on every conformant implementation: the
 // conversion of packHalf2x16 is correctly rounded in Vulkan). Saturates to +-inf like fp16.
 float nb_round_half(float x) { return unpackHalf2x16(packHalf2x16(vec2(x, 0.0f))).x; }
@@ -23,7 +31,7 @@ vec4 nb_neural_level_features(vec3 p, uint l) {
     vec3 frac;
     nb_grid_position(lv, p, cell, frac);
     vec4 sum = vec4(0.0f);
-    for (uint c = 0u; c < NB_GRID_CORNERS; ++c) {
+    NB_GRID_UNROLL for (uint c = 0u; c < NB_GRID_CORNERS; ++c) {
         float w = nb_grid_corner_weight(frac, c);
         uvec2 e = neural_grid[nb_grid_corner_entry(lv, cell, c)];
         vec4 v = vec4(unpackHalf2x16(e.x), unpackHalf2x16(e.y));

@@ -20,6 +20,8 @@
 #extension GL_NV_cooperative_matrix : require
 #extension GL_KHR_memory_scope_semantics : require
 #extension GL_EXT_shader_explicit_arithmetic_types_float16 : require
+#extension GL_EXT_control_flow_attributes : require
+#extension GL_KHR_shader_subgroup_basic : require
 #include "shared/mlp.h"
 #include "shared/neural_gpu.h"
 
@@ -34,51 +36,105 @@
 // instead of 2.
 #define NB_COOP_STRIDE 104u
 
+// Kernel variants (the including pass defines them before including this file):
+// NB_COOP_FAST 1: every loop fully unrolled (no dynamically indexed cooperative-matrix arrays or
+// elements) and only subgroup barriers inside the MLP (each subgroup reads and writes only its own 32
+// rows, so no other subgroup has to wait).
+// NB_COOP_WSHARED 1 (needs NB_COOP_FAST): the three 64x64 hidden-layer weight matrices copied once per
+// workgroup into shared memory (row stride 72 halves: conflict-free tile loads), 27 KiB; the including
+// shader declares `uvec4 neural_mlp_v4[]` on the same binding as neural_mlp_h and calls
+// nb_coop_load_weights() before the workgroup barrier that follows feature staging.
+#ifndef NB_COOP_FAST
+#define NB_COOP_FAST 0
+#endif
+#ifndef NB_COOP_WSHARED
+#define NB_COOP_WSHARED 0
+#endif
+#if NB_COOP_FAST
+#define NB_UNROLL [[unroll]]
+#define NB_COOP_SYNC() subgroupBarrier()
+#else
+#define NB_UNROLL
+#define NB_COOP_SYNC() barrier()
+#endif
+#define NB_COOP_WSTRIDE 72u
+
 // Layer inputs and outputs, in place: each layer loads its whole input tile set into accumulators
 // before any output is stored (a barrier separates the two), so one buffer serves all layers.
 shared float16_t nb_sh_x[NB_NEURAL_GROUP * NB_COOP_STRIDE];
 shared float nb_sh_y[NB_NEURAL_GROUP * NB_MLP_OUTPUTS_PADDED];
+#if NB_COOP_WSHARED
+shared float16_t nb_sh_w[3u * NB_MLP_WIDTH * NB_COOP_WSTRIDE];
+
+void nb_coop_load_weights() {
+    const uint base = nb_mlp_layer_offset(1u) / 8u;
+    const uint chunks = 3u * NB_MLP_WIDTH * NB_MLP_WIDTH / 8u;
+    for (uint i = gl_LocalInvocationID.x; i < chunks; i += gl_WorkGroupSize.x) {
+        uvec4 v = neural_mlp_v4[base + i];
+        uint row = i / (NB_MLP_WIDTH / 8u);
+        uint o = row * NB_COOP_WSTRIDE + (i % (NB_MLP_WIDTH / 8u)) * 8u;
+        f16vec2 h0 = unpackFloat2x16(v.x);
+        f16vec2 h1 = unpackFloat2x16(v.y);
+        f16vec2 h2 = unpackFloat2x16(v.z);
+        f16vec2 h3 = unpackFloat2x16(v.w);
+        nb_sh_w[o] = h0.x;
+        nb_sh_w[o + 1u] = h0.y;
+        nb_sh_w[o + 2u] = h1.x;
+        nb_sh_w[o + 3u] = h1.y;
+        nb_sh_w[o + 4u] = h2.x;
+        nb_sh_w[o + 5u] = h2.y;
+        nb_sh_w[o + 6u] = h3.x;
+        nb_sh_w[o + 7u] = h3.y;
+    }
+}
+#endif
 
 #define NB_FCM(BITS) fcoopmatNV<BITS, gl_ScopeSubgroup, 16, 16>
 
 // One hidden layer for the 32 rows of this subgroup: X[:, 0:64] = half(relu(X[:, 0:K] * W_m^T)).
-#define NB_COOP_HIDDEN_LAYER(M, K)                                                                    \
+#define NB_COOP_HIDDEN_LAYER(K, WBUF, WOFF, WSTRIDE)                                                                    \
     {                                                                                                 \
         NB_FCM(NB_COOP_ACC_BITS) acc[8];                                                              \
-        for (uint j = 0u; j < 8u; ++j) acc[j] = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));             \
-        for (uint kt = 0u; kt < (K) / 16u; ++kt) {                                                    \
+        NB_UNROLL for (uint j = 0u; j < 8u; ++j) acc[j] = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));             \
+        NB_UNROLL for (uint kt = 0u; kt < (K) / 16u; ++kt) {                                          \
             NB_FCM(16) a0;                                                                            \
             NB_FCM(16) a1;                                                                            \
             coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE + kt * 16u, NB_COOP_STRIDE, false);     \
             coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE + kt * 16u, NB_COOP_STRIDE, false); \
-            for (uint nt = 0u; nt < 4u; ++nt) {                                                       \
+            NB_UNROLL for (uint nt = 0u; nt < 4u; ++nt) {                                             \
                 NB_FCM(16) b;                                                                         \
-                coopMatLoadNV(b, neural_mlp_h, nb_mlp_layer_offset(M) + kt * 16u * NB_MLP_WIDTH + nt * 16u, NB_MLP_WIDTH, false); \
+                coopMatLoadNV(b, WBUF, (WOFF) + kt * 16u * (WSTRIDE) + nt * 16u, (WSTRIDE), false);        \
                 acc[nt] = coopMatMulAddNV(a0, b, acc[nt]);                                            \
                 acc[4u + nt] = coopMatMulAddNV(a1, b, acc[4u + nt]);                                  \
             }                                                                                         \
         }                                                                                             \
-        barrier();                                                                                    \
-        for (uint j = 0u; j < 8u; ++j) {                                                              \
-            for (int e = 0; e < acc[j].length(); ++e) acc[j][e] = max(acc[j][e], NB_ACC_T(0.0));      \
+        NB_COOP_SYNC();                                                                               \
+        NB_UNROLL for (uint j = 0u; j < 8u; ++j) {                                                    \
+            NB_UNROLL for (int e = 0; e < acc[j].length(); ++e) acc[j][e] = max(acc[j][e], NB_ACC_T(0.0));      \
             NB_FCM(16) o = NB_FCM(16)(acc[j]);                                                        \
             uint r = row0 + (j >> 2u) * 16u;                                                          \
             coopMatStoreNV(o, nb_sh_x, r * NB_COOP_STRIDE + (j & 3u) * 16u, NB_COOP_STRIDE, false);  \
         }                                                                                             \
-        barrier();                                                                                    \
+        NB_COOP_SYNC();                                                                               \
     }
 
 void nb_mlp_forward_coopmat() {
     uint row0 = (gl_LocalInvocationID.x / NB_COOP_ROWS) * NB_COOP_ROWS;
-    NB_COOP_HIDDEN_LAYER(0u, NB_MLP_INPUTS)
-    NB_COOP_HIDDEN_LAYER(1u, NB_MLP_WIDTH)
-    NB_COOP_HIDDEN_LAYER(2u, NB_MLP_WIDTH)
-    NB_COOP_HIDDEN_LAYER(3u, NB_MLP_WIDTH)
+    NB_COOP_HIDDEN_LAYER(NB_MLP_INPUTS, neural_mlp_h, nb_mlp_layer_offset(0u), NB_MLP_WIDTH)
+#if NB_COOP_WSHARED
+    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, nb_sh_w, 0u, NB_COOP_WSTRIDE)
+    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, nb_sh_w, NB_MLP_WIDTH * NB_COOP_WSTRIDE, NB_COOP_WSTRIDE)
+    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, nb_sh_w, 2u * NB_MLP_WIDTH * NB_COOP_WSTRIDE, NB_COOP_WSTRIDE)
+#else
+    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_h, nb_mlp_layer_offset(1u), NB_MLP_WIDTH)
+    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_h, nb_mlp_layer_offset(2u), NB_MLP_WIDTH)
+    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_h, nb_mlp_layer_offset(3u), NB_MLP_WIDTH)
+#endif
     // Output layer (16 x 64, rows 8..15 zero padding): fp32 pre-activation (R4).
     {
         NB_FCM(NB_COOP_ACC_BITS) acc0 = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));
         NB_FCM(NB_COOP_ACC_BITS) acc1 = acc0;
-        for (uint kt = 0u; kt < NB_MLP_WIDTH / 16u; ++kt) {
+        NB_UNROLL for (uint kt = 0u; kt < NB_MLP_WIDTH / 16u; ++kt) {
             NB_FCM(16) b;
             coopMatLoadNV(b, neural_mlp_h, nb_mlp_layer_offset(NB_MLP_HIDDEN_LAYERS) + kt * 16u * NB_MLP_OUTPUTS_PADDED,
                           NB_MLP_OUTPUTS_PADDED, false);
@@ -94,16 +150,16 @@ void nb_mlp_forward_coopmat() {
         coopMatStoreNV(y0, nb_sh_y, row0 * NB_MLP_OUTPUTS_PADDED, NB_MLP_OUTPUTS_PADDED, false);
         coopMatStoreNV(y1, nb_sh_y, (row0 + 16u) * NB_MLP_OUTPUTS_PADDED, NB_MLP_OUTPUTS_PADDED, false);
     }
-    barrier();
+    NB_COOP_SYNC();
 }
 
 // Writes one query's 96 features (rounded to fp16, R1) into its row of nb_sh_x, level by level (no
 // per-point array stays live); zeros when !valid.
 void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
     uint base = local * NB_COOP_STRIDE;
-    for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
+    NB_UNROLL for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
         vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
-        for (uint l = 0u; l < NB_GRID_MAX_LEVELS; ++l) {
+        NB_UNROLL for (uint l = 0u; l < NB_GRID_MAX_LEVELS; ++l) {
             vec4 v = valid ? nb_neural_level_features(p, l) : vec4(0.0f);
             uint o = base + nb_feature_slot(k, l, 0u);
             nb_sh_x[o] = float16_t(v.x);
