@@ -8,6 +8,21 @@
 
 namespace nbvh::vk {
 
+namespace {
+// A transfer write (copy or fill) made visible to every later shader, indirect-argument or transfer
+// read: run_now waits for completion, but the queue does not order memory for later submissions.
+void transfer_write_to_later_use(VkCommandBuffer cmd) {
+    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT |
+                            VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT |
+                             VK_PIPELINE_STAGE_TRANSFER_BIT,
+                         0, 1, &barrier, 0, nullptr, 0, nullptr);
+}
+} // namespace
+
 Buffer::Buffer(const Context& ctx, VkDeviceSize bytes, MemoryKind kind, VkBufferUsageFlags extra_usage,
                const std::string& name)
     : ctx_(&ctx), size_(bytes), kind_(kind), name_(name) {
@@ -91,16 +106,7 @@ void Buffer::upload(const void* data, VkDeviceSize bytes, VkDeviceSize offset) {
     ctx_->run_now([&](VkCommandBuffer cmd) {
         VkBufferCopy region{0, offset, bytes};
         vkCmdCopyBuffer(cmd, staging.handle(), buffer_, 1, &region);
-        // Make the copy visible to every later shader read (run_now waits, but the queue does not
-        // order memory for later submissions by itself).
-        VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-        barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT |
-                                VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT;
-        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT |
-                                 VK_PIPELINE_STAGE_TRANSFER_BIT,
-                             0, 1, &barrier, 0, nullptr, 0, nullptr);
+        transfer_write_to_later_use(cmd);
     });
 }
 
@@ -134,14 +140,7 @@ void Buffer::fill(uint32_t word) {
     VkDeviceSize bytes = std::max<VkDeviceSize>(4, size_ & ~VkDeviceSize(3));
     ctx_->run_now([&](VkCommandBuffer cmd) {
         vkCmdFillBuffer(cmd, buffer_, 0, bytes, word);
-        VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-        barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT |
-                                VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT;
-        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT |
-                                 VK_PIPELINE_STAGE_TRANSFER_BIT,
-                             0, 1, &barrier, 0, nullptr, 0, nullptr);
+        transfer_write_to_later_use(cmd);
     });
 }
 
