@@ -38,8 +38,10 @@ NeuralKernelChoice choose_neural_kernel(const vk::DeviceFeatures& dev, NeuralPat
 std::string coopmat_unavailable_reason(const vk::DeviceFeatures& dev);
 
 // Shader of the fp32-accumulating cooperative-matrix kernel: kind "eval" or "query". The environment
-// variable NBVH_NEURAL_COOP_VARIANT (benchmarking only) picks a variant: "f" (default: unrolled, subgroup
-// barriers), "base" (the v5-v7 kernel) or "w" (f + hidden weights in shared memory; 5x slower on the H200).
+// variable NBVH_NEURAL_COOP_VARIANT (benchmarking only) picks a variant (results/neural/README.md, v8/v9):
+// "g" (default: MLP loops unrolled, subgroup barriers, gather loops rolled), "base" (the v5-v7 kernel),
+// "f" (g + gather unrolled), "r"/"q" (row-tile-wise MLP, gather rolled/unrolled), "w" (f + hidden
+// weights in shared memory). All give identical decisions; g is the fastest on the H200.
 const char* coopmat_fp32_shader(const char* kind);
 
 // Host-side packing (pure CPU, unit-testable).

@@ -12,8 +12,9 @@
 #include "shared/neural_query.h"
 #include "shared/neural_gpu.h"
 
-// The cooperative-matrix kernels with NB_COOP_FAST unroll the corner loop (8 independent loads in flight).
-#if defined(NB_COOP_FAST) && NB_COOP_FAST
+// Cooperative-matrix kernels with NB_COOP_GATHER_UNROLL or NB_COOP_CORNER_UNROLL unroll the corner loop
+// (8 loads in flight).
+#if (defined(NB_COOP_GATHER_UNROLL) && NB_COOP_GATHER_UNROLL) || (defined(NB_COOP_CORNER_UNROLL) && NB_COOP_CORNER_UNROLL)
 #extension GL_EXT_control_flow_attributes : require
 #define NB_GRID_UNROLL [[unroll]]
 #else

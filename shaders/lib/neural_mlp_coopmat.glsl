@@ -50,6 +50,33 @@
 #ifndef NB_COOP_WSHARED
 #define NB_COOP_WSHARED 0
 #endif
+// NB_COOP_GATHER_UNROLL 1: the feature staging loops (3 points x 8 levels x 8 corners) fully unrolled.
+#ifndef NB_COOP_GATHER_UNROLL
+#define NB_COOP_GATHER_UNROLL NB_COOP_FAST
+#endif
+// NB_COOP_ROWWISE 1 (needs NB_COOP_FAST): each hidden layer one 16-row tile at a time: its K/16 input
+// tiles loaded into registers first, then output column tiles two at a time (fewer live registers than
+// 8 accumulators; B tiles loaded once per row tile instead of once per 32 rows).
+// NB_COOP_GATHER_PAIRS 1: the staging loop fetches two levels per iteration (16 loads in flight with an
+// unrolled corner loop, without unrolling all 24 levels).
+#ifndef NB_COOP_GATHER_PAIRS
+#define NB_COOP_GATHER_PAIRS 0
+#endif
+#ifndef NB_COOP_ROWWISE
+#define NB_COOP_ROWWISE 0
+#endif
+// NB_COOP_GATHER_ROLLED 1: the staging loops kept as loops ([[dont_unroll]]; spirv-opt -O otherwise
+// unrolls the 3 x 8 iterations itself).
+#ifndef NB_COOP_GATHER_ROLLED
+#define NB_COOP_GATHER_ROLLED 0
+#endif
+#if NB_COOP_GATHER_UNROLL
+#define NB_GATHER_UNROLL [[unroll]]
+#elif NB_COOP_GATHER_ROLLED
+#define NB_GATHER_UNROLL [[dont_unroll]]
+#else
+#define NB_GATHER_UNROLL
+#endif
 #if NB_COOP_FAST
 #define NB_UNROLL [[unroll]]
 #define NB_COOP_SYNC() subgroupBarrier()
@@ -118,6 +145,44 @@ void nb_coop_load_weights() {
         NB_COOP_SYNC();                                                                               \
     }
 
+#if NB_COOP_ROWWISE
+#undef NB_COOP_HIDDEN_LAYER
+#define NB_COOP_COL_PAIR(RB, NP, K, WBUF, WOFF, WSTRIDE)                                           \
+    {                                                                                                 \
+    NB_FCM(NB_COOP_ACC_BITS) c0 = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));                    \
+    NB_FCM(NB_COOP_ACC_BITS) c1 = c0;                                                         \
+    NB_UNROLL for (uint kt = 0u; kt < (K) / 16u; ++kt) {                                      \
+        NB_FCM(16) b0;                                                                        \
+        NB_FCM(16) b1;                                                                        \
+        coopMatLoadNV(b0, WBUF, (WOFF) + kt * 16u * (WSTRIDE) + (NP) * 32u, (WSTRIDE), false);  \
+        coopMatLoadNV(b1, WBUF, (WOFF) + kt * 16u * (WSTRIDE) + (NP) * 32u + 16u, (WSTRIDE), false); \
+        c0 = coopMatMulAddNV(a[kt], b0, c0);                                                  \
+        c1 = coopMatMulAddNV(a[kt], b1, c1);                                                  \
+    }                                                                                         \
+    NB_UNROLL for (int e = 0; e < c0.length(); ++e) {                                         \
+        c0[e] = max(c0[e], NB_ACC_T(0.0));                                                    \
+        c1[e] = max(c1[e], NB_ACC_T(0.0));                                                    \
+    }                                                                                         \
+    NB_FCM(16) o0 = NB_FCM(16)(c0);                                                           \
+    NB_FCM(16) o1 = NB_FCM(16)(c1);                                                           \
+    coopMatStoreNV(o0, nb_sh_x, (RB) * NB_COOP_STRIDE + (NP) * 32u, NB_COOP_STRIDE, false);     \
+    coopMatStoreNV(o1, nb_sh_x, (RB) * NB_COOP_STRIDE + (NP) * 32u + 16u, NB_COOP_STRIDE, false); \
+    }
+#define NB_COOP_ROW_TILE(RB, K, WBUF, WOFF, WSTRIDE)                                                  \
+    {                                                                                                 \
+        NB_FCM(16) a[(K) / 16u];                                                                      \
+        NB_UNROLL for (uint kt = 0u; kt < (K) / 16u; ++kt)                                            \
+            coopMatLoadNV(a[kt], nb_sh_x, (RB) * NB_COOP_STRIDE + kt * 16u, NB_COOP_STRIDE, false);  \
+        NB_COOP_SYNC();                                                                               \
+        NB_COOP_COL_PAIR(RB, 0u, K, WBUF, WOFF, WSTRIDE)                                              \
+        NB_COOP_COL_PAIR(RB, 1u, K, WBUF, WOFF, WSTRIDE)                                              \
+    }
+#define NB_COOP_HIDDEN_LAYER(K, WBUF, WOFF, WSTRIDE)                                                  \
+    NB_COOP_ROW_TILE(row0, K, WBUF, WOFF, WSTRIDE)                                                    \
+    NB_COOP_ROW_TILE(row0 + 16u, K, WBUF, WOFF, WSTRIDE)                                              \
+    NB_COOP_SYNC();
+#endif
+
 void nb_mlp_forward_coopmat() {
     uint row0 = (gl_LocalInvocationID.x / NB_COOP_ROWS) * NB_COOP_ROWS;
     NB_COOP_HIDDEN_LAYER(NB_MLP_INPUTS, neural_mlp_h, nb_mlp_layer_offset(0u), NB_MLP_WIDTH)
@@ -157,9 +222,28 @@ void nb_mlp_forward_coopmat() {
 // per-point array stays live); zeros when !valid.
 void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
     uint base = local * NB_COOP_STRIDE;
-    NB_UNROLL for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
+#if NB_COOP_GATHER_PAIRS
+    NB_GATHER_UNROLL for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
         vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
-        NB_UNROLL for (uint l = 0u; l < NB_GRID_MAX_LEVELS; ++l) {
+        NB_GATHER_UNROLL for (uint l = 0u; l < NB_GRID_MAX_LEVELS; l += 2u) {
+            vec4 v = valid ? nb_neural_level_features(p, l) : vec4(0.0f);
+            vec4 w = valid ? nb_neural_level_features(p, l + 1u) : vec4(0.0f);
+            uint o = base + nb_feature_slot(k, l, 0u);
+            uint o1 = base + nb_feature_slot(k, l + 1u, 0u);
+            nb_sh_x[o] = float16_t(v.x);
+            nb_sh_x[o + 1u] = float16_t(v.y);
+            nb_sh_x[o + 2u] = float16_t(v.z);
+            nb_sh_x[o + 3u] = float16_t(v.w);
+            nb_sh_x[o1] = float16_t(w.x);
+            nb_sh_x[o1 + 1u] = float16_t(w.y);
+            nb_sh_x[o1 + 2u] = float16_t(w.z);
+            nb_sh_x[o1 + 3u] = float16_t(w.w);
+        }
+    }
+#else
+    NB_GATHER_UNROLL for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
+        vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
+        NB_GATHER_UNROLL for (uint l = 0u; l < NB_GRID_MAX_LEVELS; ++l) {
             vec4 v = valid ? nb_neural_level_features(p, l) : vec4(0.0f);
             uint o = base + nb_feature_slot(k, l, 0u);
             nb_sh_x[o] = float16_t(v.x);
@@ -168,6 +252,7 @@ void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
             nb_sh_x[o + 3u] = float16_t(v.w);
         }
     }
+#endif
 }
 
 #endif

@@ -3,5 +3,6 @@
 #version 460
 #define NB_COOP_ACC_BITS 32
 #define NB_COOP_FAST 1
+#define NB_COOP_GATHER_UNROLL 1
 #define NB_COOP_WSHARED 1
 #include "lib/neural_query_coopmat_main.glsl"
