@@ -145,7 +145,6 @@ const char* coopmat_fp32_shader(const char* kind) {
     if (variant == "w") return eval ? "passes/neural_eval_coop32w.comp" : "passes/neural_query_coop32w.comp";
     if (variant == "f") return eval ? "passes/neural_eval_coop32f.comp" : "passes/neural_query_coop32f.comp";
     if (variant == "r") return eval ? "passes/neural_eval_coop32r.comp" : "passes/neural_query_coop32r.comp";
-    if (variant == "p") return eval ? "passes/neural_eval_coop32p.comp" : "passes/neural_query_coop32p.comp";
     if (variant == "q") return eval ? "passes/neural_eval_coop32q.comp" : "passes/neural_query_coop32q.comp";
     return eval ? "passes/neural_eval_coop32g.comp" : "passes/neural_query_coop32g.comp"; // "g", the default
 }

@@ -12,9 +12,8 @@
 #include "shared/neural_query.h"
 #include "shared/neural_gpu.h"
 
-// Cooperative-matrix kernels with NB_COOP_GATHER_UNROLL or NB_COOP_CORNER_UNROLL unroll the corner loop
-// (8 loads in flight).
-#if (defined(NB_COOP_GATHER_UNROLL) && NB_COOP_GATHER_UNROLL) || (defined(NB_COOP_CORNER_UNROLL) && NB_COOP_CORNER_UNROLL)
+// Cooperative-matrix kernels with NB_COOP_GATHER_UNROLL unroll the corner loop (8 loads in flight).
+#if defined(NB_COOP_GATHER_UNROLL) && NB_COOP_GATHER_UNROLL
 #extension GL_EXT_control_flow_attributes : require
 #define NB_GRID_UNROLL [[unroll]]
 #else

@@ -57,23 +57,11 @@
 // NB_COOP_ROWWISE 1 (needs NB_COOP_FAST): each hidden layer one 16-row tile at a time: its K/16 input
 // tiles loaded into registers first, then output column tiles two at a time (fewer live registers than
 // 8 accumulators; B tiles loaded once per row tile instead of once per 32 rows).
-// NB_COOP_GATHER_PAIRS 1: the staging loop fetches two levels per iteration (16 loads in flight with an
-// unrolled corner loop, without unrolling all 24 levels).
-#ifndef NB_COOP_GATHER_PAIRS
-#define NB_COOP_GATHER_PAIRS 0
-#endif
 #ifndef NB_COOP_ROWWISE
 #define NB_COOP_ROWWISE 0
 #endif
-// NB_COOP_GATHER_ROLLED 1: the staging loops kept as loops ([[dont_unroll]]; spirv-opt -O otherwise
-// unrolls the 3 x 8 iterations itself).
-#ifndef NB_COOP_GATHER_ROLLED
-#define NB_COOP_GATHER_ROLLED 0
-#endif
 #if NB_COOP_GATHER_UNROLL
 #define NB_GATHER_UNROLL [[unroll]]
-#elif NB_COOP_GATHER_ROLLED
-#define NB_GATHER_UNROLL [[dont_unroll]]
 #else
 #define NB_GATHER_UNROLL
 #endif
@@ -222,25 +210,6 @@ void nb_mlp_forward_coopmat() {
 // per-point array stays live); zeros when !valid.
 void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
     uint base = local * NB_COOP_STRIDE;
-#if NB_COOP_GATHER_PAIRS
-    NB_GATHER_UNROLL for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
-        vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
-        NB_GATHER_UNROLL for (uint l = 0u; l < NB_GRID_MAX_LEVELS; l += 2u) {
-            vec4 v = valid ? nb_neural_level_features(p, l) : vec4(0.0f);
-            vec4 w = valid ? nb_neural_level_features(p, l + 1u) : vec4(0.0f);
-            uint o = base + nb_feature_slot(k, l, 0u);
-            uint o1 = base + nb_feature_slot(k, l + 1u, 0u);
-            nb_sh_x[o] = float16_t(v.x);
-            nb_sh_x[o + 1u] = float16_t(v.y);
-            nb_sh_x[o + 2u] = float16_t(v.z);
-            nb_sh_x[o + 3u] = float16_t(v.w);
-            nb_sh_x[o1] = float16_t(w.x);
-            nb_sh_x[o1 + 1u] = float16_t(w.y);
-            nb_sh_x[o1 + 2u] = float16_t(w.z);
-            nb_sh_x[o1 + 3u] = float16_t(w.w);
-        }
-    }
-#else
     NB_GATHER_UNROLL for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
         vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
         NB_GATHER_UNROLL for (uint l = 0u; l < NB_GRID_MAX_LEVELS; ++l) {
@@ -252,7 +221,6 @@ void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
             nb_sh_x[o + 3u] = float16_t(v.w);
         }
     }
-#endif
 }
 
 #endif
