@@ -36,10 +36,11 @@
 // instead of 2.
 #define NB_COOP_STRIDE 104u
 
-// Kernel variants (the including pass defines them before including this file):
-// NB_COOP_FAST 1: every loop fully unrolled (no dynamically indexed cooperative-matrix arrays or
+// Kernel variants (the including pass defines them before including this file; H200 figures in
+// results/neural/README.md v8-v10; the default fp32 kernel is passes/neural_*_coop32g = FAST 1, others 0):
+// NB_COOP_FAST 1: every MLP loop fully unrolled (no dynamically indexed cooperative-matrix arrays or
 // elements) and only subgroup barriers inside the MLP (each subgroup reads and writes only its own 32
-// rows, so no other subgroup has to wait).
+// rows, so no other subgroup has to wait): MLP alone 0.63 -> 1.77 G queries/s.
 // NB_COOP_WSHARED 1 (needs NB_COOP_FAST): the three 64x64 hidden-layer weight matrices copied once per
 // workgroup into shared memory (row stride 72 halves: conflict-free tile loads), 27 KiB; the including
 // shader declares `uvec4 neural_mlp_v4[]` on the same binding as neural_mlp_h and calls
@@ -50,7 +51,8 @@
 #ifndef NB_COOP_WSHARED
 #define NB_COOP_WSHARED 0
 #endif
-// NB_COOP_GATHER_UNROLL 1: the feature staging loops (3 points x 8 levels x 8 corners) fully unrolled.
+// NB_COOP_GATHER_UNROLL 1: the feature staging loops (3 points x 8 levels x 8 corners) fully unrolled
+// (slower fused kernel on the H200: 0.43 vs 0.55 G/s random, presumably fewer resident warps).
 #ifndef NB_COOP_GATHER_UNROLL
 #define NB_COOP_GATHER_UNROLL NB_COOP_FAST
 #endif
