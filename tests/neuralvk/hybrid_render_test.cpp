@@ -18,9 +18,8 @@
 #include "engine/scene/camera.h"
 #include "engine/scene/environment.h"
 #include "engine/scene/gltf_loader.h"
+#include "tests/neuralvk/trained_bunny.h"
 #include "tests/support/test_support.h"
-#include "trainer/model_export.h"
-#include "trainer/trainer.h"
 
 #include <gtest/gtest.h>
 
@@ -33,32 +32,8 @@ namespace {
 
 constexpr float FLIP_BOUND = 0.10f;
 
-struct Fixture {
-    Scene scene;
-    NeuralModel model;
-};
-
-const Fixture& trained_bunny() {
-    static Fixture f = [] {
-        Fixture x;
-        SceneLoadOptions lo;
-        lo.neural_glob = "*";
-        x.scene = load_gltf(test::scenes_dir() / "stanford_bunny" / "stanford_bunny.glb", lo);
-        const TrainingAsset asset = make_training_asset(x.scene, pick_neural_mesh(x.scene));
-        TrainOptions opt = default_train_options(BackendChoice::cpu);
-        opt.steps = 300;
-        opt.batch_size = 2048;
-        opt.target_nodes = 200;
-        opt.network.log2_hash_size = 14;
-        opt.lods = 2;
-        opt.threads = 2;
-        auto backend = make_backend(BackendChoice::cpu, asset, opt);
-        const TrainResult r = train_asset(asset, opt, *backend);
-        x.model = make_neural_model(asset, r, opt, "stanford_bunny", 0);
-        return x;
-    }();
-    return f;
-}
+using Fixture = test::TrainedBunny; // trained_bunny.h: trained once per executable
+using test::trained_bunny;
 
 struct Rendered {
     Image image;
