@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 
 #include "engine/core/error.h"
@@ -11,7 +12,22 @@
 
 namespace nbvh::render {
 
+uint32_t effective_leaves_per_round(const NeuralRenderOptions& o) {
+    uint32_t k = o.leaves_per_round;
+    if (const char* env = std::getenv("NBVH_NEURAL_LEAVES_PER_ROUND"); env && *env) {
+        char* end = nullptr;
+        const unsigned long v = std::strtoul(env, &end, 10);
+        if (*end != '\0' || v == 0 || v > NB_NL_MAX_LEAVES_PER_ROUND)
+            throw Error(strfmt("NBVH_NEURAL_LEAVES_PER_ROUND must be in 1..%u", NB_NL_MAX_LEAVES_PER_ROUND));
+        k = uint32_t(v);
+    }
+    if (k == 0 || k > NB_NL_MAX_LEAVES_PER_ROUND)
+        throw Error(strfmt("neural leaves per round must be in 1..%u", NB_NL_MAX_LEAVES_PER_ROUND));
+    return k;
+}
+
 void validate(const NeuralRenderOptions& o, const Scene& scene) {
+    effective_leaves_per_round(o);
     if (!(o.roughness >= 0.0f && o.roughness <= 1.0f)) throw Error("--neural-roughness must be in [0, 1]");
     if (!(o.metallic >= 0.0f && o.metallic <= 1.0f)) throw Error("--neural-metallic must be in [0, 1]");
     if (o.max_rounds == 0 || o.max_rounds > 256) throw Error("--neural-max-leaves must be in 1..256");
@@ -69,7 +85,12 @@ void apply_classical_materials(const Scene& scene, GpuSceneData& data, float rou
 NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const NeuralRenderOptions& o,
                          uint32_t ray_capacity)
     : ctx_(ctx), model_(ctx, model), kernel_(choose_neural_kernel(ctx.features(), o.path)),
-      rounds_(o.max_rounds), batched_(std::min(o.max_rounds, o.batched_rounds)), capacity_(ray_capacity) {
+      rounds_(o.max_rounds), capacity_(ray_capacity) {
+    params_.leaves_per_round = effective_leaves_per_round(o);
+    // Every round queues leaves_per_round leaves per ray still going, or finishes it (fewer leaves left
+    // in front of its hit): after ceil(max_rounds / leaves_per_round) rounds no ray is left.
+    const uint32_t needed = (o.max_rounds + params_.leaves_per_round - 1) / params_.leaves_per_round;
+    batched_ = std::min(needed, o.batched_rounds);
     params_.box = model_.box();
     params_.root_primary = model_.lod_root(o.lod);
     params_.root_secondary = model_.lod_root(o.secondary_lod < 0 ? o.lod : uint32_t(o.secondary_lod));
@@ -88,8 +109,9 @@ void NeuralStage::install(std::vector<vk::Buffer>& buffers) {
     if (buffers.size() < NB_NEURAL_BINDING_END) buffers.resize(NB_NEURAL_BINDING_END);
     model_.move_into(buffers[NB_BIND_NEURAL_LEVELS], buffers[NB_BIND_NEURAL_GRID], buffers[NB_BIND_NEURAL_MLP],
                      buffers[NB_BIND_NEURAL_MLP_T], buffers[NB_BIND_NBVH_NODES], buffers[NB_BIND_NBVH_BOUNDS]);
-    // Two halves (ping-pong between a query round and the traversal that follows it).
-    buffers[NB_BIND_PENDING_LEAVES] = vk::Buffer(ctx_, 2ull * std::max(capacity_, 1u) * sizeof(GpuPendingLeaf),
+    // Two halves (ping-pong between a query round and the traversal that follows it) of
+    // leaves_per_round pairs per ray.
+    buffers[NB_BIND_PENDING_LEAVES] = vk::Buffer(ctx_, 2ull * params_.leaves_per_round * std::max(capacity_, 1u) * sizeof(GpuPendingLeaf),
                                                  vk::MemoryKind::device, 0, "pending leaves");
     // Path rays at [0, capacity), shadow rays at [capacity, 2 capacity).
     buffers[NB_BIND_NEURAL_STATE] = vk::Buffer(ctx_, 2ull * std::max(capacity_, 1u) * sizeof(GpuNeuralRayState),

@@ -41,8 +41,16 @@ struct NeuralRenderOptions {
     // invocation per ray, scalar queries). Default: all rounds batched (the tail measured slower on the
     // H200: its longest ray serialises ~10 scalar queries per pass).
     uint32_t batched_rounds = 256;
+    // Leaves a ray queues per round (1..NB_NL_MAX_LEAVES_PER_ROUND): the next ones in key order in front
+    // of its best hit, so one traversal and one query round serve several leaf visits (the extra ones
+    // are speculative: their hits cannot beat the closest, same image). The environment variable
+    // NBVH_NEURAL_LEAVES_PER_ROUND overrides it (benchmarks).
+    uint32_t leaves_per_round = 4;
     float threshold = NB_VISIBILITY_THRESHOLD;
 };
+
+// Leaves per round after the NBVH_NEURAL_LEAVES_PER_ROUND override (throws nbvh::Error when out of range).
+uint32_t effective_leaves_per_round(const NeuralRenderOptions& options);
 
 // Throws nbvh::Error on out-of-range constants (roughness/metallic outside [0,1], rounds 0 or > 256,
 // LoDs beyond the model's, a model with no neural instance in the scene).
@@ -69,6 +77,7 @@ public:
     const char* query_shader() const;
     uint32_t rounds() const { return rounds_; }
     uint32_t batched_rounds() const { return batched_; }
+    uint32_t leaves_per_round() const { return params_.leaves_per_round; }
     const GpuNeuralParams& params() const { return params_; }
 
 private:

@@ -60,8 +60,10 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     uint64_t cap = std::min<uint64_t>(pixels, std::max<uint32_t>(options_.max_wave_pixels, 64));
     cap = std::min<uint64_t>(cap, range / (2ull * NB_RAY_WORDS * 4ull));
     // Hybrid renders keep a neural state per path and per shadow ray in one binding (neural_stage.h).
-    if (options_.neural.model && !options_.neural.classical)
+    if (options_.neural.model && !options_.neural.classical) {
         cap = std::min<uint64_t>(cap, range / (2ull * sizeof(GpuNeuralRayState)));
+        cap = std::min<uint64_t>(cap, range / (2ull * effective_leaves_per_round(options_.neural) * sizeof(GpuPendingLeaf)));
+    }
     capacity_ = uint32_t(cap);
 
     features_ = derive_features(scene, environment);

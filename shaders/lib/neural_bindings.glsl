@@ -23,4 +23,7 @@ layout(set = 0, binding = NB_BIND_NEURAL_STATE, scalar) buffer NeuralStateBuffer
 layout(set = 0, binding = NB_BIND_NEURAL_PARAMS, scalar) readonly buffer NeuralParamsBuffer { GpuNeuralParams neural_params; };
 layout(set = 0, binding = NB_BIND_NEURAL_COUNTERS, scalar) coherent buffer NeuralCountersBuffer { GpuNeuralCounters neural_counters; };
 
+// Slot k of half `half_` of the pending queue (each half holds leaves_per_round pairs per ray).
+uint nb_nl_pending_index(uint half_, uint k) { return half_ * ray_capacity() * neural_params.leaves_per_round + k; }
+
 #endif

@@ -1,13 +1,14 @@
 // Neural query pass of the wavefront loop (passes/neural_query_*.comp): one batched dispatch over the
 // queued (ray, leaf) pairs. Each pair: the ray in the instance's object space, the 3-point encoding of
 // its leaf segment (reversed when the origin is inside the leaf), the network, the decode; a visible,
-// accepted hit in front of the ray's start and of its best hit so far becomes its best hit (normal in
-// world space). The ray then goes back to traversal (next leaf) in the next round.
+// accepted hit in front of the ray's start is stored with the pair; the ray's resumed traversal (next
+// round) keeps the closest (passes/neural_traverse.comp, neural_shadow.comp).
 #ifndef NB_NEURAL_QUERY_PASS_GLSL
 #define NB_NEURAL_QUERY_PASS_GLSL
 
 struct NbPendingQuery {
     bool valid;
+    uint slot; // index in pending_leaves
     GpuPendingLeaf pl;
     vec3 org;  // object space
     vec3 dir;
@@ -18,6 +19,7 @@ struct NbPendingQuery {
 NbPendingQuery nb_load_pending(uint k) {
     NbPendingQuery r;
     r.valid = k < neural_counters.pending_active;
+    r.slot = 0u;
     r.org = vec3(0.0f);
     r.dir = vec3(0.0f, 0.0f, 1.0f);
     r.pl.ray = 0u;
@@ -27,7 +29,8 @@ NbPendingQuery nb_load_pending(uint k) {
     r.pl.t_exit = 0.0f;
     if (!r.valid) return r;
     uint cap = ray_capacity();
-    r.pl = pending_leaves[((pc.mode >> 2u) & 1u) * cap + k];
+    r.slot = nb_nl_pending_index((pc.mode >> 2u) & 1u, k);
+    r.pl = pending_leaves[r.slot];
     GpuInstance inst = instances[r.pl.instance];
     bool shadow = r.pl.ray >= cap;
     vec3 o = shadow ? shadow_load3(NB_SHADOW_ORIGIN, r.pl.ray - cap) : ray_load3(pc.in_queue, NB_RAY_ORIGIN, r.pl.ray);
@@ -37,25 +40,35 @@ NbPendingQuery nb_load_pending(uint k) {
     return r;
 }
 
-void nb_apply_neural_result(NbPendingQuery r, float y[NB_MLP_OUTPUTS]) {
+// The accepted hit of a pair (t NB_INF: none): visible and accepted, in front of the ray's start and
+// its tmax (shadow rays); world-space normal.
+float nb_neural_pair_hit(NbPendingQuery r, float y[NB_MLP_OUTPUTS], out vec3 normal, out vec3 albedo) {
     GpuNeuralHit h = nb_neural_decode(neural_params.box, y, r.pl.t_enter, r.pl.t_exit, neural_params.threshold);
     uint ray = r.pl.ray;
-    GpuNeuralRayState st = neural_state[ray];
     uint cap = ray_capacity();
     bool shadow = ray >= cap;
     float tmin = shadow ? 0.0f : uintBitsToFloat(ray_load1(pc.in_queue, NB_RAY_T_RESUME, ray));
     float tmax = shadow ? uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, ray - cap)) : NB_INF;
+    normal = vec3(0.0f, 0.0f, 1.0f);
+    albedo = h.albedo;
     if ((h.flags & (NB_NEURAL_VISIBLE | NB_NEURAL_ACCEPTED)) == (NB_NEURAL_VISIBLE | NB_NEURAL_ACCEPTED) &&
-        h.t > tmin && h.t < tmax && h.t < st.best_t) {
-        st.best_t = h.t;
+        h.t > tmin && h.t < tmax) {
         vec3 n = nb_xform_normal(instances[r.pl.instance].world_to_object, h.normal);
         float len = length(n);
-        st.normal = len > 0.0f ? n / len : vec3(0.0f, 0.0f, 1.0f);
-        st.albedo = h.albedo;
-        st.instance = r.pl.instance;
+        normal = len > 0.0f ? n / len : vec3(0.0f, 0.0f, 1.0f);
+        return h.t;
     }
-    st.status = NB_NRAY_TRACE; // one pair per ray per round: no write races
-    neural_state[ray] = st;
+    return NB_INF;
+}
+
+// Batched rounds: the pair's result goes to its pending slot; the ray's resumed traversal applies the
+// results of its pairs in key order (several pairs of one ray per round: no shared writes here).
+void nb_apply_neural_result(NbPendingQuery r, float y[NB_MLP_OUTPUTS]) {
+    vec3 normal, albedo;
+    float t = nb_neural_pair_hit(r, y, normal, albedo);
+    pending_leaves[r.slot].hit_t = t;
+    pending_leaves[r.slot].hit_normal = normal;
+    pending_leaves[r.slot].hit_albedo = albedo;
 }
 
 #endif

@@ -1,9 +1,12 @@
 // The neural leaf kind of the two-level traversal (issue 4; included by lib/traverse.glsl before its
 // TLAS leaf handler). A ray entering a neural instance (through the TLAS, in the instance's object
 // space, so instancing works) walks the instance's N-BVH nearest-first:
-//   closest-hit rays (path rays) look for the NEXT leaf to query: the smallest ordering key
-//     (max(t_entry, tmin), instance, leaf) above the last queried one whose entry is still in front of
-//     the best hit; passes/neural_traverse.comp queues it and passes/neural_query_*.comp evaluates it;
+//   closest-hit rays (path rays) look for the NEXT leaves to query: the leaves_per_round smallest
+//     ordering keys (max(t_entry, tmin), instance, leaf) above the last queried one whose entry is still
+//     in front of the best hit; passes/neural_traverse.comp queues them (one traversal for several leaf
+//     visits) and passes/neural_query_*.comp evaluates them; the resumed traversal applies their hits
+//     in key order, so the closest accepted hit wins as with one leaf per round (a leaf's hit lies at
+//     or behind its key: the extra, speculative leaves behind the best hit cannot change it);
 //   shadow rays do the same (passes/neural_shadow.comp) after their triangle any-hit test: the leaf
 //     queue serves both, so shadow queries are batched through the same query kernels.
 // Leaf intervals: shared/neural_gpu.h nb_neural_leaf_interval (dilated box, tmin = -inf).
@@ -16,11 +19,14 @@ uint g_nl_root = 0u;              // N-BVH cut (LoD) root of this ray
 float g_nl_last_t = -NB_INF;      // last queued key (exclusive lower bound)
 uint g_nl_last_inst = 0u;
 uint g_nl_last_leaf = 0u;
-float g_nl_cand_t = NB_INF;       // best candidate so far
-uint g_nl_cand_inst = NB_NO_HIT;
-uint g_nl_cand_leaf = 0u;
-float g_nl_cand_entry = 0.0f;
-float g_nl_cand_exit = 0.0f;
+// The g_nl_want smallest keys above the last queued one, sorted (g_nl_cand_n of them so far).
+uint g_nl_want = 1u;
+uint g_nl_cand_n = 0u;
+float g_nl_cand_t[NB_NL_MAX_LEAVES_PER_ROUND];
+uint g_nl_cand_inst[NB_NL_MAX_LEAVES_PER_ROUND];
+uint g_nl_cand_leaf[NB_NL_MAX_LEAVES_PER_ROUND];
+float g_nl_cand_entry[NB_NL_MAX_LEAVES_PER_ROUND];
+float g_nl_cand_exit[NB_NL_MAX_LEAVES_PER_ROUND];
 uint g_nl_inst = 0u;              // instance being walked
 vec3 g_nl_inv_dir;
 
@@ -29,6 +35,9 @@ bool nb_nl_key_less(float ta, uint ia, uint la, float tb, uint ib, uint lb) {
     if (ia != ib) return ia < ib;
     return la < lb;
 }
+
+// Key of the worst kept candidate while the list is full (else +inf): the bound a new one must beat.
+float nb_nl_bound_t() { return g_nl_cand_n < g_nl_want ? NB_INF : g_nl_cand_t[g_nl_want - 1u]; }
 
 void nb_neural_leaf(uint first, uint count) {
     for (uint k = 0u; k < count; ++k) {
@@ -40,12 +49,28 @@ void nb_neural_leaf(uint first, uint count) {
         float key = max(te, g_tmin);
         if (!(key < g_tmax)) continue;
         if (!nb_nl_key_less(g_nl_last_t, g_nl_last_inst, g_nl_last_leaf, key, g_nl_inst, node)) continue;
-        if (!nb_nl_key_less(key, g_nl_inst, node, g_nl_cand_t, g_nl_cand_inst, g_nl_cand_leaf)) continue;
-        g_nl_cand_t = key;
-        g_nl_cand_inst = g_nl_inst;
-        g_nl_cand_leaf = node;
-        g_nl_cand_entry = te;
-        g_nl_cand_exit = tx;
+        if (g_nl_cand_n == g_nl_want) {
+            uint w = g_nl_want - 1u;
+            if (!nb_nl_key_less(key, g_nl_inst, node, g_nl_cand_t[w], g_nl_cand_inst[w], g_nl_cand_leaf[w])) continue;
+        } else {
+            g_nl_cand_n += 1u;
+        }
+        // Insertion into the sorted list (the last entry drops out when it was full).
+        uint j = g_nl_cand_n - 1u;
+        while (j > 0u && nb_nl_key_less(key, g_nl_inst, node, g_nl_cand_t[j - 1u], g_nl_cand_inst[j - 1u],
+                                        g_nl_cand_leaf[j - 1u])) {
+            g_nl_cand_t[j] = g_nl_cand_t[j - 1u];
+            g_nl_cand_inst[j] = g_nl_cand_inst[j - 1u];
+            g_nl_cand_leaf[j] = g_nl_cand_leaf[j - 1u];
+            g_nl_cand_entry[j] = g_nl_cand_entry[j - 1u];
+            g_nl_cand_exit[j] = g_nl_cand_exit[j - 1u];
+            j -= 1u;
+        }
+        g_nl_cand_t[j] = key;
+        g_nl_cand_inst[j] = g_nl_inst;
+        g_nl_cand_leaf[j] = node;
+        g_nl_cand_entry[j] = te;
+        g_nl_cand_exit[j] = tx;
     }
 }
 
@@ -59,7 +84,7 @@ void nb_traverse_neural_instance(uint instance) {
     // Cull subtrees behind the current candidate while walking (restored after: the TLAS and the
     // triangles are culled by hits only).
     float saved_tmax = g_tmax;
-    g_tmax = min(g_tmax, g_nl_cand_t);
+    g_tmax = min(g_tmax, nb_nl_bound_t());
     NB_TRAVERSE_BVH(nbvh_nodes, g_nl_root, g_obj_org, g_nl_inv_dir, nb_neural_leaf)
     g_tmax = saved_tmax;
 }
@@ -70,34 +95,67 @@ void nb_traverse_neural_instance(uint instance) {
 uint nb_nl_op(uint mode) { return mode & 3u; }
 uint nb_nl_half(uint mode) { return (mode >> 2u) & 1u; }
 
-// Queues the candidate of the last traversal (if any, in front of `limit`, within the ray's leaf budget)
-// into half `half` of the pending queue; returns false when the ray is finished.
+// Leaves a ray may queue in its next traversal: the round size, within its leaf budget.
+uint nb_nl_want(GpuNeuralRayState st) {
+    uint left = neural_params.max_rounds > st.rounds ? neural_params.max_rounds - st.rounds : 0u;
+    return max(1u, min(min(neural_params.leaves_per_round, NB_NL_MAX_LEAVES_PER_ROUND), left));
+}
+
+// Queues the candidates of the last traversal in front of `limit` (within the ray's leaf budget),
+// contiguously in key order, into half `half` of the pending queue; returns false when the ray is finished.
 bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, inout GpuNeuralRayState st) {
-    bool found = g_nl_cand_inst != NB_NO_HIT && g_nl_cand_t < limit;
-    if (!found || st.rounds >= neural_params.max_rounds) return false;
-    uint k = atomicAdd(counters.pending_count, 1u);
-    GpuPendingLeaf pl;
-    pl.ray = state_index;
-    pl.instance = g_nl_cand_inst;
-    pl.leaf = g_nl_cand_leaf;
-    pl.t_enter = g_nl_cand_entry;
-    pl.t_exit = g_nl_cand_exit;
-    pending_leaves[half_ * ray_capacity() + k] = pl;
-    st.key_t = g_nl_cand_t;
-    st.key_instance = g_nl_cand_inst;
-    st.key_leaf = g_nl_cand_leaf;
+    uint n = 0u;
+    while (n < g_nl_cand_n && g_nl_cand_t[n] < limit) n += 1u;
+    if (n == 0u || st.rounds >= neural_params.max_rounds) return false;
+    uint k = atomicAdd(counters.pending_count, n);
+    for (uint j = 0u; j < n; ++j) {
+        GpuPendingLeaf pl;
+        pl.ray = state_index;
+        pl.instance = g_nl_cand_inst[j];
+        pl.leaf = g_nl_cand_leaf[j];
+        pl.t_enter = g_nl_cand_entry[j];
+        pl.t_exit = g_nl_cand_exit[j];
+        pl.group = j == 0u ? n : 0u;
+        pl.hit_t = NB_INF;
+        pl.hit_normal = vec3(0.0f, 0.0f, 1.0f);
+        pl.hit_albedo = vec3(0.0f);
+        pending_leaves[nb_nl_pending_index(half_, k + j)] = pl;
+    }
+    st.key_t = g_nl_cand_t[n - 1u];
+    st.key_instance = g_nl_cand_inst[n - 1u];
+    st.key_leaf = g_nl_cand_leaf[n - 1u];
     st.status = NB_NRAY_PENDING;
-    st.rounds += 1u;
+    st.rounds += n;
     return true;
 }
 
-void nb_nl_begin(GpuNeuralRayState st, uint root) {
+// A neural hit in front of the ray's best one becomes its best hit (pairs applied in key order, so the
+// first of equal hits wins, as with one leaf per round).
+void nb_nl_take_hit(inout GpuNeuralRayState st, float t, vec3 normal, vec3 albedo, uint instance) {
+    if (t < st.best_t) {
+        st.best_t = t;
+        st.normal = normal;
+        st.albedo = albedo;
+        st.instance = instance;
+    }
+}
+
+// The resumed traversal of a ray: the results of its `group` pairs from pending slot `slot` on.
+void nb_nl_reduce_group(uint slot, uint group, inout GpuNeuralRayState st) {
+    for (uint j = 0u; j < group; ++j) {
+        GpuPendingLeaf pl = pending_leaves[slot + j];
+        nb_nl_take_hit(st, pl.hit_t, pl.hit_normal, pl.hit_albedo, pl.instance);
+    }
+    st.status = NB_NRAY_TRACE;
+}
+
+void nb_nl_begin(GpuNeuralRayState st, uint root, uint want) {
     g_nl_root = root;
     g_nl_last_t = st.key_t;
     g_nl_last_inst = st.key_instance;
     g_nl_last_leaf = st.key_leaf;
-    g_nl_cand_t = NB_INF;
-    g_nl_cand_inst = NB_NO_HIT;
+    g_nl_want = want;
+    g_nl_cand_n = 0u;
 }
 
 // A path ray with no leaf left: a neural hit closer than the triangle hit replaces it in the hit SOA.

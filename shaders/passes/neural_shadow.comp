@@ -2,7 +2,8 @@
 // search and batched queries as path rays (passes/neural_traverse.comp), with any-hit semantics. The
 // state of shadow ray i lives at neural_state[capacity + i]; its best_t < NB_INF means "occluded".
 //   op 0: every shadow ray: triangle any-hit (occluded -> done), else queue the first neural leaf;
-//   op 1: the rays of the pairs just queried: occluded -> done, else queue the next leaf.
+//   op 1: the rays of the pairs just queried (first pair of each ray's group): any accepted hit of the
+//         group -> occluded, done; else queue the next leaves.
 // shadow.comp then reads the result instead of tracing.
 #version 460
 #include "lib/bindings.glsl"
@@ -19,10 +20,14 @@ void main() {
     if (op == 1u) {
         uint k = gl_GlobalInvocationID.x;
         if (k >= neural_counters.pending_active) return;
-        i = pending_leaves[(half_ ^ 1u) * cap + k].ray - cap;
+        uint slot = nb_nl_pending_index(half_ ^ 1u, k);
+        GpuPendingLeaf pl = pending_leaves[slot];
+        if (pl.group == 0u) return; // the first pair of the ray's group resumes it
+        i = pl.ray - cap;
         st = neural_state[cap + i];
-        if (st.status != NB_NRAY_TRACE) return;
-        if (st.best_t < NB_INF) { // the query found an occluder
+        if (st.status != NB_NRAY_PENDING) return;
+        nb_nl_reduce_group(slot, pl.group, st);
+        if (st.best_t < NB_INF) { // a query of the group found an occluder
             st.status = NB_NRAY_DONE;
             neural_state[cap + i] = st;
             return;
@@ -37,7 +42,7 @@ void main() {
     float tmax = uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, i));
     uint pixel = shadow_load1(NB_SHADOW_PIXEL, i);
     g_alpha_seed = nb_pcg_hash(pixel ^ (pc.depth << 24u) ^ pc.sample_index);
-    nb_nl_begin(st, neural_params.root_secondary);
+    nb_nl_begin(st, neural_params.root_secondary, nb_nl_want(st));
     g_nl_skip_triangles = op != 0u;
     nb_trace(org, dir, 0.0f, tmax, true);
     if (op == 0u && g_hit_instance != NB_NO_HIT) {

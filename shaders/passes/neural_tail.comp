@@ -1,8 +1,8 @@
 // The tail of a neural loop (path or shadow rays): after a few batched rounds only a few rays still
 // have leaves to visit, and each further round would cost three dependent dispatches for them. This
 // pass takes the pairs queued by the last batched round (pending half nb_nl_half(pc.mode)) and finishes
-// each ray in one invocation: query (scalar network), apply, re-traverse the neural instances for the
-// next leaf, ... until no leaf is left in front of its best hit or its leaf budget is spent. Same
+// each ray in one invocation (the first pair of its group): the group's queries (scalar network), then
+// re-traverse the neural instances for the next leaf, query, ... until no leaf is left in front of its best hit or its leaf budget is spent. Same
 // decisions as the batched rounds (same ordering keys, same decode), without the round trips.
 #version 460
 #include "lib/bindings.glsl"
@@ -13,9 +13,18 @@
 
 layout(local_size_x = NB_WAVEFRONT_GROUP) in;
 
+// Query of one pair with the scalar network: its accepted hit (NB_INF: none).
+float nb_tail_query(NbPendingQuery r, out vec3 normal, out vec3 albedo) {
+    vec3 p0, p1, p2;
+    nb_segment_points(neural_params.box, r.org, r.dir, r.pl.t_enter, r.pl.t_exit, p0, p1, p2);
+    float y[NB_MLP_OUTPUTS];
+    nb_neural_forward_scalar(p0, p1, p2, y);
+    return nb_neural_pair_hit(r, y, normal, albedo);
+}
+
 void main() {
     NbPendingQuery r = nb_load_pending(gl_GlobalInvocationID.x);
-    if (!r.valid) return;
+    if (!r.valid || r.pl.group == 0u) return; // the first pair of each ray's group finishes the ray
     uint cap = ray_capacity();
     uint ray = r.pl.ray;
     bool shadow = ray >= cap;
@@ -27,41 +36,47 @@ void main() {
     g_alpha_seed = shadow ? nb_pcg_hash(shadow_load1(NB_SHADOW_PIXEL, i) ^ (pc.depth << 24u) ^ pc.sample_index)
                           : ray_load1(pc.in_queue, NB_RAY_RNG, i);
     uint root = (shadow || pc.depth != 0u) ? neural_params.root_secondary : neural_params.root_primary;
+    GpuNeuralRayState st = neural_state[ray];
+    // The group queued by the last batched round, in key order.
+    uint group = r.pl.group;
+    for (uint j = 0u; j < group; ++j) {
+        NbPendingQuery rj = j == 0u ? r : nb_load_pending(gl_GlobalInvocationID.x + j);
+        vec3 n, a;
+        float t = nb_tail_query(rj, n, a);
+        nb_nl_take_hit(st, t, n, a, rj.pl.instance);
+    }
     for (uint guard = 0u; guard <= neural_params.max_rounds; ++guard) {
-        vec3 p0, p1, p2;
-        nb_segment_points(neural_params.box, r.org, r.dir, r.pl.t_enter, r.pl.t_exit, p0, p1, p2);
-        float y[NB_MLP_OUTPUTS];
-        nb_neural_forward_scalar(p0, p1, p2, y);
-        nb_apply_neural_result(r, y);
-        GpuNeuralRayState st = neural_state[ray];
         if (shadow && st.best_t < NB_INF) { // occluded
             st.status = NB_NRAY_DONE;
             neural_state[ray] = st;
             return;
         }
         float limit = shadow ? tmax : min(st.tri_t, st.best_t);
-        nb_nl_begin(st, root);
+        nb_nl_begin(st, root, 1u);
         g_nl_skip_triangles = true;
         nb_trace(org, dir, tmin, limit, shadow);
-        bool found = g_nl_cand_inst != NB_NO_HIT && g_nl_cand_t < limit && st.rounds < neural_params.max_rounds;
+        bool found = g_nl_cand_n > 0u && g_nl_cand_t[0] < limit && st.rounds < neural_params.max_rounds;
         if (!found) {
             if (shadow) st.status = NB_NRAY_DONE;
             else nb_nl_finish_path(i, st);
             neural_state[ray] = st;
             return;
         }
-        st.key_t = g_nl_cand_t;
-        st.key_instance = g_nl_cand_inst;
-        st.key_leaf = g_nl_cand_leaf;
+        st.key_t = g_nl_cand_t[0];
+        st.key_instance = g_nl_cand_inst[0];
+        st.key_leaf = g_nl_cand_leaf[0];
         st.rounds += 1u;
-        neural_state[ray] = st;
-        atomicAdd(neural_counters.queries_total, 1u); // the next query (the first one was counted by neural_args)
-        r.pl.instance = g_nl_cand_inst;
-        r.pl.leaf = g_nl_cand_leaf;
-        r.pl.t_enter = g_nl_cand_entry;
-        r.pl.t_exit = g_nl_cand_exit;
+        atomicAdd(neural_counters.queries_total, 1u); // the next query (the first ones were counted by neural_args)
+        r.pl.instance = g_nl_cand_inst[0];
+        r.pl.leaf = g_nl_cand_leaf[0];
+        r.pl.t_enter = g_nl_cand_entry[0];
+        r.pl.t_exit = g_nl_cand_exit[0];
         GpuInstance inst = instances[r.pl.instance];
         r.org = nb_xform_point(inst.world_to_object, org);
         r.dir = nb_xform_vector(inst.world_to_object, dir);
+        vec3 n, a;
+        float t = nb_tail_query(r, n, a);
+        nb_nl_take_hit(st, t, n, a, r.pl.instance);
     }
+    neural_state[ray] = st;
 }

@@ -1,10 +1,11 @@
 // Neural traversal rounds of path-ray queue pc.in_queue (replaces passes/traverse.comp when the scene
 // has neural instances; engine/render/neural_stage.h records the loop). Operation nb_nl_op(pc.mode):
 //   0: every ray of the queue: full traversal; stores the closest triangle hit in the hit SOA and
-//      queues the first neural leaf in front of it (pending half 0);
+//      queues the first neural leaves in front of it (pending half 0);
 //   1: the rays of the pairs just queried (pending half nb_nl_half(pc.mode) ^ 1, dispatched indirectly
-//      over them): re-traverse the neural instances only (triangles are known), culled by
-//      min(triangle hit, best neural hit), and queue the next leaf into half nb_nl_half(pc.mode);
+//      over them; the first pair of each ray's group): apply the group's hits in key order, re-traverse
+//      the neural instances only (triangles are known), culled by min(triangle hit, best neural hit),
+//      and queue the next leaves into half nb_nl_half(pc.mode);
 //   2: every ray: rays still undecided keep the best hit found so far (safety net: after the last
 //      batched round passes/neural_tail.comp finishes every ray).
 // A ray is finished when no leaf key remains in front of its best hit; then a closer neural hit
@@ -24,9 +25,13 @@ void main() {
     if (op == 1u) {
         uint k = gl_GlobalInvocationID.x;
         if (k >= neural_counters.pending_active) return;
-        i = pending_leaves[(half_ ^ 1u) * ray_capacity() + k].ray;
+        uint slot = nb_nl_pending_index(half_ ^ 1u, k);
+        GpuPendingLeaf pl = pending_leaves[slot];
+        if (pl.group == 0u) return; // the first pair of the ray's group resumes it
+        i = pl.ray;
         st = neural_state[i];
-        if (st.status != NB_NRAY_TRACE) return;
+        if (st.status != NB_NRAY_PENDING) return;
+        nb_nl_reduce_group(slot, pl.group, st);
     } else {
         i = gl_GlobalInvocationID.x;
         if (i >= queue_count(q)) return;
@@ -44,7 +49,7 @@ void main() {
     vec3 dir = ray_load3(q, NB_RAY_DIR, i);
     g_alpha_seed = ray_load1(q, NB_RAY_RNG, i);
     float t_resume = uintBitsToFloat(ray_load1(q, NB_RAY_T_RESUME, i));
-    nb_nl_begin(st, pc.depth == 0u ? neural_params.root_primary : neural_params.root_secondary);
+    nb_nl_begin(st, pc.depth == 0u ? neural_params.root_primary : neural_params.root_secondary, nb_nl_want(st));
     if (op == 0u) {
         g_nl_skip_triangles = false;
         nb_trace(org, dir, t_resume, NB_INF, false);

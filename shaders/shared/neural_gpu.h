@@ -81,6 +81,9 @@ NB_FN bool nb_neural_leaf_interval(vec3 org, vec3 inv_dir, vec3 lo, vec3 hi, NB_
 // leaf): each round re-traverses the scene for the smallest key above the last one whose entry is still
 // in front of the best hit (triangle or neural), so overlapping leaves of one or several instances are
 // all queried in order and the closest accepted hit wins.
+// Leaves a ray may queue per round (the next ones in key order in front of its best hit): one
+// traversal and one query round serve several leaf visits; the pending queue holds that many pairs per ray.
+#define NB_NL_MAX_LEAVES_PER_ROUND 4u
 #define NB_NRAY_TRACE 0u    // needs a traversal round
 #define NB_NRAY_PENDING 1u  // a (ray, leaf) pair is queued
 #define NB_NRAY_DONE 2u
@@ -109,7 +112,7 @@ struct GpuNeuralParams {
     float metallic;
     float threshold;      // visibility threshold
     uint max_rounds;      // leaves queried per ray at most (then the best hit so far is kept)
-    uint pad0;
+    uint leaves_per_round; // 1..NB_NL_MAX_LEAVES_PER_ROUND leaves queued per ray per traversal round
     uint pad1;
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 64, "GpuNeuralParams layout");

@@ -62,8 +62,15 @@ struct GpuPendingLeaf {
     uint leaf;      // N-BVH leaf index
     float t_enter;  // leaf interval along the ray (world t)
     float t_exit;
+    // A ray queues up to GpuNeuralParams.leaves_per_round pairs per round, contiguously, in key order:
+    // the first one holds their count (its resumed traversal reduces them), the others 0.
+    uint group;
+    // Written by the query pass: the accepted hit of this pair (hit_t NB_INF: none), world space.
+    float hit_t;
+    vec3 hit_normal;
+    vec3 hit_albedo;
 };
-NB_STATIC_ASSERT(sizeof(GpuPendingLeaf) == 20, "GpuPendingLeaf layout");
+NB_STATIC_ASSERT(sizeof(GpuPendingLeaf) == 52, "GpuPendingLeaf layout");
 
 // ---- Queue counters and indirect arguments -------------------------------------------------------
 struct GpuDispatchArgs {

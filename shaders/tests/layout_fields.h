@@ -72,7 +72,7 @@
     F(height) F(env_width) F(env_height) F(env_intensity) F(env_rotation) F(env_inv_mean)         \
     F(light_count) F(light_total_power) F(max_depth) F(rr_start_depth) F(seed) F(spp)             \
     F(wave_capacity) F(ray_epsilon) F(instance_count) F(pad0) F(pad1)
-#define NB_LAYOUT_FIELDS_GpuPendingLeaf(F) F(ray) F(instance) F(leaf) F(t_enter) F(t_exit)
+#define NB_LAYOUT_FIELDS_GpuPendingLeaf(F) F(ray) F(instance) F(leaf) F(t_enter) F(t_exit) F(group) F(hit_t) F(hit_normal) F(hit_albedo)
 #define NB_LAYOUT_FIELDS_GpuDispatchArgs(F) F(x) F(y) F(z)
 #define NB_LAYOUT_FIELDS_GpuQueueCounters(F)                                                      \
     F(ray_dispatch.x) F(ray_dispatch.y) F(ray_dispatch.z)                                         \
@@ -92,7 +92,7 @@
     F(tri_t) F(tri_instance) F(tri_triangle) F(rounds)
 #define NB_LAYOUT_FIELDS_GpuNeuralParams(F)                                                       \
     F(box.center) F(box.depth_pad) F(box.extent) F(box.fixed_depth_eps) F(root_primary)           \
-    F(root_secondary) F(roughness) F(metallic) F(threshold) F(max_rounds) F(pad0) F(pad1)
+    F(root_secondary) F(roughness) F(metallic) F(threshold) F(max_rounds) F(leaves_per_round) F(pad1)
 #define NB_LAYOUT_FIELDS_GpuNeuralCounters(F) F(pending_active) F(queries_total) F(shadow_queries) F(rounds)
 
 // --- distinct, exactly representable, non-zero values ------------------------------------------

@@ -42,7 +42,8 @@ struct Rendered {
 };
 
 Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPath::scalar, float threshold = 0.5f,
-                      uint32_t lod = 0, int32_t secondary_lod = -1, uint32_t batched_rounds = 256) {
+                      uint32_t lod = 0, int32_t secondary_lod = -1, uint32_t batched_rounds = 256,
+                      uint32_t leaves_per_round = NeuralRenderOptions{}.leaves_per_round) {
     vk::ContextOptions co;
     co.device = vk::DeviceChoice::cpu;
     co.validation = true;
@@ -62,6 +63,7 @@ Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPat
     o.neural.lod = lod;
     o.neural.secondary_lod = secondary_lod;
     o.neural.batched_rounds = batched_rounds;
+    o.neural.leaves_per_round = leaves_per_round;
     if (hybrid) o.neural.model = &f.model;
     else o.neural.classical = true;
     WavefrontRenderer r(ctx, f.scene, accel, default_sky(), cam, o);
@@ -117,13 +119,14 @@ TEST(HybridRender, LevelOfDetailOptions) {
 }
 
 // The per-ray tail pass (passes/neural_tail.comp) takes the same decisions as batched rounds: all rounds
-// batched, one batched round + tail, and everything in the tail give the same image.
+// batched, one batched round + tail, and everything in the tail give the same image (one leaf per round:
+// then the three visit exactly the same leaves, so the query counts agree too).
 TEST(HybridRender, TailPassMatchesBatchedRounds) {
     NBVH_REQUIRE_SHARED();
     const Fixture& f = trained_bunny();
-    const Rendered all_batched = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 16);
-    const Rendered one = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 1);
-    const Rendered tail = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 0);
+    const Rendered all_batched = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 16, 1);
+    const Rendered one = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 1, 1);
+    const Rendered tail = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 0, 1);
     EXPECT_EQ(all_batched.validation + one.validation + tail.validation, 0);
     const float f1 = flip_hdr(all_batched.image, one.image).mean;
     const float f0 = flip_hdr(all_batched.image, tail.image).mean;
@@ -134,6 +137,33 @@ TEST(HybridRender, TailPassMatchesBatchedRounds) {
     EXPECT_LT(f0, 1e-3f);
     EXPECT_EQ(all_batched.stats.neural_queries, one.stats.neural_queries);
     EXPECT_EQ(all_batched.stats.neural_queries, tail.stats.neural_queries);
+}
+
+// Several leaves per ray per round (speculative queries of the next leaves in key order) pick the same
+// closest hit as one leaf per round: same image, at least as many queries, fewer rounds. Also with the
+// tail pass after one batched round (it takes a group of several pairs per ray).
+TEST(HybridRender, LeavesPerRoundKeepTheImage) {
+    NBVH_REQUIRE_SHARED();
+    const Fixture& f = trained_bunny();
+    const Rendered k1 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 1);
+    const Rendered k2 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 2);
+    const Rendered k4 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 4);
+    const Rendered k4_tail = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 1, 4);
+    EXPECT_EQ(k1.validation + k2.validation + k4.validation + k4_tail.validation, 0);
+    const float f2 = flip_hdr(k1.image, k2.image).mean;
+    const float f4 = flip_hdr(k1.image, k4.image).mean;
+    const float ft = flip_hdr(k1.image, k4_tail.image).mean;
+    std::printf("1 leaf per round vs 2: FLIP %.2e; vs 4: %.2e; vs 4 + tail: %.2e; queries %llu / %llu / %llu, "
+                "rounds %llu / %llu / %llu\n",
+                f2, f4, ft, (unsigned long long)k1.stats.neural_queries, (unsigned long long)k2.stats.neural_queries,
+                (unsigned long long)k4.stats.neural_queries, (unsigned long long)k1.stats.neural_rounds,
+                (unsigned long long)k2.stats.neural_rounds, (unsigned long long)k4.stats.neural_rounds);
+    EXPECT_LT(f2, 1e-3f);
+    EXPECT_LT(f4, 1e-3f);
+    EXPECT_LT(ft, 1e-3f);
+    EXPECT_GE(k2.stats.neural_queries, k1.stats.neural_queries);
+    EXPECT_GE(k4.stats.neural_queries, k2.stats.neural_queries);
+    EXPECT_LT(k4.stats.neural_rounds, k1.stats.neural_rounds);
 }
 
 TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
@@ -154,6 +184,11 @@ TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
     o.max_rounds = 0;
     EXPECT_THROW(validate(o, f.scene), Error);
     o.max_rounds = 8;
+    o.leaves_per_round = 0;
+    EXPECT_THROW(validate(o, f.scene), Error);
+    o.leaves_per_round = NB_NL_MAX_LEAVES_PER_ROUND + 1;
+    EXPECT_THROW(validate(o, f.scene), Error);
+    o.leaves_per_round = 2;
     EXPECT_NO_THROW(validate(o, f.scene));
     Scene plain = f.scene;
     for (Instance& i : plain.instances) i.neural = false;
