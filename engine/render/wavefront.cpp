@@ -62,7 +62,11 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     // Hybrid renders keep a neural state per path and per shadow ray in one binding (neural_stage.h).
     if (options_.neural.model && !options_.neural.classical) {
         cap = std::min<uint64_t>(cap, range / (2ull * sizeof(GpuNeuralRayState)));
-        cap = std::min<uint64_t>(cap, range / (2ull * effective_leaves_per_round(options_.neural) * sizeof(GpuPendingLeaf)));
+        const uint64_t k = effective_leaves_per_round(options_.neural);
+        cap = std::min<uint64_t>(cap, range / (2ull * k * sizeof(GpuPendingLeaf)));
+        // The query pass is dispatched indirectly over up to k pairs per ray (not checked on the host).
+        if (dev.max_workgroup_count[0] > 0)
+            cap = std::min<uint64_t>(cap, uint64_t(dev.max_workgroup_count[0]) * NB_NEURAL_GROUP / k);
     }
     capacity_ = uint32_t(cap);
 
