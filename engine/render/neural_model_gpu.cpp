@@ -1,7 +1,6 @@
 #include "engine/render/neural_model_gpu.h"
 
 #include <algorithm>
-#include <cstdlib>
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
@@ -138,15 +137,7 @@ uint32_t NeuralModelGpu::lod_root(uint32_t lod) const {
 }
 
 const char* coopmat_fp32_shader(const char* kind) {
-    const char* v = std::getenv("NBVH_NEURAL_COOP_VARIANT");
-    const std::string variant = v ? v : "";
-    const bool eval = std::string(kind) == "eval";
-    if (variant == "base") return eval ? "passes/neural_eval_coop32.comp" : "passes/neural_query_coop32.comp";
-    if (variant == "w") return eval ? "passes/neural_eval_coop32w.comp" : "passes/neural_query_coop32w.comp";
-    if (variant == "f") return eval ? "passes/neural_eval_coop32f.comp" : "passes/neural_query_coop32f.comp";
-    if (variant == "r") return eval ? "passes/neural_eval_coop32r.comp" : "passes/neural_query_coop32r.comp";
-    if (variant == "q") return eval ? "passes/neural_eval_coop32q.comp" : "passes/neural_query_coop32q.comp";
-    return eval ? "passes/neural_eval_coop32g.comp" : "passes/neural_query_coop32g.comp"; // "g", the default
+    return std::string(kind) == "eval" ? "passes/neural_eval_coop32.comp" : "passes/neural_query_coop32.comp";
 }
 
 namespace {

@@ -37,11 +37,9 @@ NeuralKernelChoice choose_neural_kernel(const vk::DeviceFeatures& dev, NeuralPat
 // Why the cooperative-matrix path is unavailable ("" when it is available).
 std::string coopmat_unavailable_reason(const vk::DeviceFeatures& dev);
 
-// Shader of the fp32-accumulating cooperative-matrix kernel: kind "eval" or "query". The environment
-// variable NBVH_NEURAL_COOP_VARIANT (benchmarking only) picks a variant (results/neural/README.md, v8/v9):
-// "g" (default: MLP loops unrolled, subgroup barriers, gather loops rolled), "base" (the v5-v7 kernel),
-// "f" (g + gather unrolled), "r"/"q" (row-tile-wise MLP, gather rolled/unrolled), "w" (f + hidden
-// weights in shared memory). All give identical decisions; g is the fastest on the H200.
+// Shader of the fp32-accumulating cooperative-matrix kernel: kind "eval" or "query". It is variant "g"
+// of the kernels measured in results/neural/README.md (v8-v10: MLP loops unrolled, subgroup barriers,
+// gather loops rolled), the fastest on the H200; the slower variants were removed (git history).
 const char* coopmat_fp32_shader(const char* kind);
 
 // Host-side packing (pure CPU, unit-testable).

@@ -3,9 +3,6 @@
 #include "lib/neural_eval_common.glsl"
 #extension GL_EXT_shader_16bit_storage : require
 layout(set = 0, binding = NB_NEVAL_BIND_MLP, scalar) readonly buffer MlpBuffer { float16_t neural_mlp_h[]; };
-#if defined(NB_COOP_WSHARED) && NB_COOP_WSHARED
-layout(set = 0, binding = NB_NEVAL_BIND_MLP, scalar) readonly buffer MlpBufferV4 { uvec4 neural_mlp_v4[]; };
-#endif
 #include "lib/neural_grid.glsl"
 #include "lib/neural_mlp_coopmat.glsl"
 
@@ -26,9 +23,6 @@ void main() {
     q.t_entry = 0.0f;
     q.t_exit = 0.0f;
     if (valid) q = queries[i];
-#if NB_COOP_WSHARED
-    nb_coop_load_weights();
-#endif
     vec3 p0, p1, p2;
     nb_segment_points(pc.box, q.origin, q.dir, q.t_entry, q.t_exit, p0, p1, p2);
     if (NB_EVAL_PART == 2u) {

@@ -12,13 +12,6 @@
 #include "shared/neural_query.h"
 #include "shared/neural_gpu.h"
 
-// Cooperative-matrix kernels with NB_COOP_GATHER_UNROLL unroll the corner loop (8 loads in flight).
-#if defined(NB_COOP_GATHER_UNROLL) && NB_COOP_GATHER_UNROLL
-#extension GL_EXT_control_flow_attributes : require
-#define NB_GRID_UNROLL [[unroll]]
-#else
-#define NB_GRID_UNROLL
-#endif
 
 // Round to the nearest fp16 value (round to nearest even on every conformant implementation: the
 // conversion of packHalf2x16 is correctly rounded in Vulkan). Saturates to +-inf like fp16.
@@ -31,7 +24,7 @@ vec4 nb_neural_level_features(vec3 p, uint l) {
     vec3 frac;
     nb_grid_position(lv, p, cell, frac);
     vec4 sum = vec4(0.0f);
-    NB_GRID_UNROLL for (uint c = 0u; c < NB_GRID_CORNERS; ++c) {
+    for (uint c = 0u; c < NB_GRID_CORNERS; ++c) {
         float w = nb_grid_corner_weight(frac, c);
         uvec2 e = neural_grid[nb_grid_corner_entry(lv, cell, c)];
         vec4 v = vec4(unpackHalf2x16(e.x), unpackHalf2x16(e.y));

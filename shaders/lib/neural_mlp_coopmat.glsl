@@ -36,36 +36,13 @@
 // instead of 2.
 #define NB_COOP_STRIDE 104u
 
-// Kernel variants (the including pass defines them before including this file; H200 figures in
-// results/neural/README.md v8-v10; the default fp32 kernel is passes/neural_*_coop32g = FAST 1, others 0):
+// NB_COOP_FAST (defined by the including pass; H200 figures in results/neural/README.md v8-v10):
 // NB_COOP_FAST 1: every MLP loop fully unrolled (no dynamically indexed cooperative-matrix arrays or
 // elements) and only subgroup barriers inside the MLP (each subgroup reads and writes only its own 32
-// rows, so no other subgroup has to wait): MLP alone 0.63 -> 1.77 G queries/s.
-// NB_COOP_WSHARED 1 (needs NB_COOP_FAST): the three 64x64 hidden-layer weight matrices copied once per
-// workgroup into shared memory (row stride 72 halves: conflict-free tile loads), 27 KiB; the including
-// shader declares `uvec4 neural_mlp_v4[]` on the same binding as neural_mlp_h and calls
-// nb_coop_load_weights() before the workgroup barrier that follows feature staging.
+// rows, so no other subgroup has to wait): MLP alone 0.63 -> 1.77 G queries/s. The fp16-accumulator
+// kernel (coop16, no GPU here to re-measure it) keeps the earlier looped form (0).
 #ifndef NB_COOP_FAST
 #define NB_COOP_FAST 0
-#endif
-#ifndef NB_COOP_WSHARED
-#define NB_COOP_WSHARED 0
-#endif
-// NB_COOP_GATHER_UNROLL 1: the feature staging loops (3 points x 8 levels x 8 corners) fully unrolled
-// (slower fused kernel on the H200: 0.43 vs 0.55 G/s random, presumably fewer resident warps).
-#ifndef NB_COOP_GATHER_UNROLL
-#define NB_COOP_GATHER_UNROLL NB_COOP_FAST
-#endif
-// NB_COOP_ROWWISE 1 (needs NB_COOP_FAST): each hidden layer one 16-row tile at a time: its K/16 input
-// tiles loaded into registers first, then output column tiles two at a time (fewer live registers than
-// 8 accumulators; B tiles loaded once per row tile instead of once per 32 rows).
-#ifndef NB_COOP_ROWWISE
-#define NB_COOP_ROWWISE 0
-#endif
-#if NB_COOP_GATHER_UNROLL
-#define NB_GATHER_UNROLL [[unroll]]
-#else
-#define NB_GATHER_UNROLL
 #endif
 #if NB_COOP_FAST
 #define NB_UNROLL [[unroll]]
@@ -74,37 +51,11 @@
 #define NB_UNROLL
 #define NB_COOP_SYNC() barrier()
 #endif
-#define NB_COOP_WSTRIDE 72u
 
 // Layer inputs and outputs, in place: each layer loads its whole input tile set into accumulators
 // before any output is stored (a barrier separates the two), so one buffer serves all layers.
 shared float16_t nb_sh_x[NB_NEURAL_GROUP * NB_COOP_STRIDE];
 shared float nb_sh_y[NB_NEURAL_GROUP * NB_MLP_OUTPUTS_PADDED];
-#if NB_COOP_WSHARED
-shared float16_t nb_sh_w[3u * NB_MLP_WIDTH * NB_COOP_WSTRIDE];
-
-void nb_coop_load_weights() {
-    const uint base = nb_mlp_layer_offset(1u) / 8u;
-    const uint chunks = 3u * NB_MLP_WIDTH * NB_MLP_WIDTH / 8u;
-    for (uint i = gl_LocalInvocationID.x; i < chunks; i += gl_WorkGroupSize.x) {
-        uvec4 v = neural_mlp_v4[base + i];
-        uint row = i / (NB_MLP_WIDTH / 8u);
-        uint o = row * NB_COOP_WSTRIDE + (i % (NB_MLP_WIDTH / 8u)) * 8u;
-        f16vec2 h0 = unpackFloat2x16(v.x);
-        f16vec2 h1 = unpackFloat2x16(v.y);
-        f16vec2 h2 = unpackFloat2x16(v.z);
-        f16vec2 h3 = unpackFloat2x16(v.w);
-        nb_sh_w[o] = h0.x;
-        nb_sh_w[o + 1u] = h0.y;
-        nb_sh_w[o + 2u] = h1.x;
-        nb_sh_w[o + 3u] = h1.y;
-        nb_sh_w[o + 4u] = h2.x;
-        nb_sh_w[o + 5u] = h2.y;
-        nb_sh_w[o + 6u] = h3.x;
-        nb_sh_w[o + 7u] = h3.y;
-    }
-}
-#endif
 
 #define NB_FCM(BITS) fcoopmatNV<BITS, gl_ScopeSubgroup, 16, 16>
 
@@ -135,56 +86,13 @@ void nb_coop_load_weights() {
         NB_COOP_SYNC();                                                                               \
     }
 
-#if NB_COOP_ROWWISE
-#undef NB_COOP_HIDDEN_LAYER
-#define NB_COOP_COL_PAIR(RB, NP, K, WBUF, WOFF, WSTRIDE)                                           \
-    {                                                                                                 \
-    NB_FCM(NB_COOP_ACC_BITS) c0 = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));                    \
-    NB_FCM(NB_COOP_ACC_BITS) c1 = c0;                                                         \
-    NB_UNROLL for (uint kt = 0u; kt < (K) / 16u; ++kt) {                                      \
-        NB_FCM(16) b0;                                                                        \
-        NB_FCM(16) b1;                                                                        \
-        coopMatLoadNV(b0, WBUF, (WOFF) + kt * 16u * (WSTRIDE) + (NP) * 32u, (WSTRIDE), false);  \
-        coopMatLoadNV(b1, WBUF, (WOFF) + kt * 16u * (WSTRIDE) + (NP) * 32u + 16u, (WSTRIDE), false); \
-        c0 = coopMatMulAddNV(a[kt], b0, c0);                                                  \
-        c1 = coopMatMulAddNV(a[kt], b1, c1);                                                  \
-    }                                                                                         \
-    NB_UNROLL for (int e = 0; e < c0.length(); ++e) {                                         \
-        c0[e] = max(c0[e], NB_ACC_T(0.0));                                                    \
-        c1[e] = max(c1[e], NB_ACC_T(0.0));                                                    \
-    }                                                                                         \
-    NB_FCM(16) o0 = NB_FCM(16)(c0);                                                           \
-    NB_FCM(16) o1 = NB_FCM(16)(c1);                                                           \
-    coopMatStoreNV(o0, nb_sh_x, (RB) * NB_COOP_STRIDE + (NP) * 32u, NB_COOP_STRIDE, false);     \
-    coopMatStoreNV(o1, nb_sh_x, (RB) * NB_COOP_STRIDE + (NP) * 32u + 16u, NB_COOP_STRIDE, false); \
-    }
-#define NB_COOP_ROW_TILE(RB, K, WBUF, WOFF, WSTRIDE)                                                  \
-    {                                                                                                 \
-        NB_FCM(16) a[(K) / 16u];                                                                      \
-        NB_UNROLL for (uint kt = 0u; kt < (K) / 16u; ++kt)                                            \
-            coopMatLoadNV(a[kt], nb_sh_x, (RB) * NB_COOP_STRIDE + kt * 16u, NB_COOP_STRIDE, false);  \
-        NB_COOP_SYNC();                                                                               \
-        NB_COOP_COL_PAIR(RB, 0u, K, WBUF, WOFF, WSTRIDE)                                              \
-        NB_COOP_COL_PAIR(RB, 1u, K, WBUF, WOFF, WSTRIDE)                                              \
-    }
-#define NB_COOP_HIDDEN_LAYER(K, WBUF, WOFF, WSTRIDE)                                                  \
-    NB_COOP_ROW_TILE(row0, K, WBUF, WOFF, WSTRIDE)                                                    \
-    NB_COOP_ROW_TILE(row0 + 16u, K, WBUF, WOFF, WSTRIDE)                                              \
-    NB_COOP_SYNC();
-#endif
 
 void nb_mlp_forward_coopmat() {
     uint row0 = (gl_LocalInvocationID.x / NB_COOP_ROWS) * NB_COOP_ROWS;
     NB_COOP_HIDDEN_LAYER(NB_MLP_INPUTS, neural_mlp_h, nb_mlp_layer_offset(0u), NB_MLP_WIDTH)
-#if NB_COOP_WSHARED
-    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, nb_sh_w, 0u, NB_COOP_WSTRIDE)
-    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, nb_sh_w, NB_MLP_WIDTH * NB_COOP_WSTRIDE, NB_COOP_WSTRIDE)
-    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, nb_sh_w, 2u * NB_MLP_WIDTH * NB_COOP_WSTRIDE, NB_COOP_WSTRIDE)
-#else
     NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_h, nb_mlp_layer_offset(1u), NB_MLP_WIDTH)
     NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_h, nb_mlp_layer_offset(2u), NB_MLP_WIDTH)
     NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_h, nb_mlp_layer_offset(3u), NB_MLP_WIDTH)
-#endif
     // Output layer (16 x 64, rows 8..15 zero padding): fp32 pre-activation (R4).
     {
         NB_FCM(NB_COOP_ACC_BITS) acc0 = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));
@@ -212,9 +120,9 @@ void nb_mlp_forward_coopmat() {
 // per-point array stays live); zeros when !valid.
 void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
     uint base = local * NB_COOP_STRIDE;
-    NB_GATHER_UNROLL for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
+    for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
         vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
-        NB_GATHER_UNROLL for (uint l = 0u; l < NB_GRID_MAX_LEVELS; ++l) {
+        for (uint l = 0u; l < NB_GRID_MAX_LEVELS; ++l) {
             vec4 v = valid ? nb_neural_level_features(p, l) : vec4(0.0f);
             uint o = base + nb_feature_slot(k, l, 0u);
             nb_sh_x[o] = float16_t(v.x);

@@ -3,9 +3,6 @@
 #include "lib/bindings.glsl"
 #define NB_NEURAL_MLP_AS_HALF 1
 #include "lib/neural_bindings.glsl"
-#if defined(NB_COOP_WSHARED) && NB_COOP_WSHARED
-layout(set = 0, binding = NB_BIND_NEURAL_MLP_T, scalar) readonly buffer NeuralMlpBufferV4 { uvec4 neural_mlp_v4[]; };
-#endif
 #include "lib/neural_grid.glsl"
 #include "lib/neural_mlp_coopmat.glsl"
 #include "lib/neural_query_pass.glsl"
@@ -13,9 +10,6 @@ layout(set = 0, binding = NB_BIND_NEURAL_MLP_T, scalar) readonly buffer NeuralMl
 layout(local_size_x = NB_NEURAL_GROUP) in;
 
 void main() {
-#if NB_COOP_WSHARED
-    nb_coop_load_weights();
-#endif
     NbPendingQuery r = nb_load_pending(gl_GlobalInvocationID.x);
     vec3 p0, p1, p2;
     nb_segment_points(neural_params.box, r.org, r.dir, r.pl.t_enter, r.pl.t_exit, p0, p1, p2);

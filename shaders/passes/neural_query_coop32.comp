@@ -1,4 +1,6 @@
-// Neural query pass, fused cooperative-matrix MLP with fp32 accumulators.
+// Neural query pass through the fused cooperative-matrix MLP, fp32 accumulators;
+// (every MLP loop unrolled, subgroup barriers: lib/neural_mlp_coopmat.glsl NB_COOP_FAST).
 #version 460
 #define NB_COOP_ACC_BITS 32
+#define NB_COOP_FAST 1
 #include "lib/neural_query_coopmat_main.glsl"
