@@ -31,7 +31,6 @@ target_link_libraries(nbvh_stb INTERFACE stb)
 
 if(NBVH_BUILD_TESTS)  # (included from the top level so imported targets are global)
   find_package(GTest REQUIRED)
-  find_package(benchmark QUIET)
 endif()
 
 # GLFW + Dear ImGui (the interactive viewer, app/viewer/). Debian's libimgui-dev ships a static
