@@ -30,7 +30,10 @@ struct RenderOptions {
     uint32_t max_depth = 8;          // path segments (1: emitters and environment seen directly)
     uint32_t seed = 0;
     uint32_t rr_start_depth = 3;     // Russian roulette from this segment on
-    uint32_t max_wave_pixels = 1u << 20; // rays per queue; bounded by the device's storage range too
+    // Rays per queue (pixels per wave), further bounded by the device's storage-buffer range (lavapipe:
+    // under 1M). 4M keeps a 1080p or 1440p frame in one wave on GPUs: on the H200 two 1M waves made
+    // the 1080p classical frame ~1.5x slower than one (results/neural/README.md, v12 vs v13).
+    uint32_t max_wave_pixels = 1u << 22;
     NeuralRenderOptions neural;      // hybrid (model) or classical-reference render of neural instances
 };
 
