@@ -66,6 +66,12 @@ void run_train(const TrainArgs& a) {
     if (a.scene == "default") {
         scene = assets::make_default_scene();
         if (!a.neural_glob.empty()) mark_neural_by_glob(scene, a.neural_glob);
+        // The built-in scene has no file to hash: hash its geometry, so the model still names its source.
+        source_hash = FNV1A64_OFFSET;
+        for (const Mesh& m : scene.meshes) {
+            source_hash = fnv1a64(m.positions.data(), m.positions.size() * sizeof(m.positions[0]), source_hash);
+            source_hash = fnv1a64(m.indices.data(), m.indices.size() * sizeof(m.indices[0]), source_hash);
+        }
     } else {
         SceneLoadOptions lo;
         lo.neural_glob = a.neural_glob;
