@@ -31,7 +31,9 @@ void main() {
     } else {
         nb_coop_stage_features(local, valid, p0, p1, p2);
     }
-    barrier();
+    // Each subgroup stages and runs the MLP on only its own 32 rows: with NB_COOP_FAST a subgroup
+    // barrier (shared-memory semantics) lets one subgroup's MLP overlap the other's gather.
+    NB_COOP_SYNC();
     if (NB_EVAL_PART != 1u) nb_mlp_forward_coopmat(); // whole workgroup, uniform control flow
     if (!valid) return;
     float y[NB_MLP_OUTPUTS];

@@ -37,6 +37,37 @@ vec4 nb_neural_level_features(vec3 p, uint l) {
     return vec4(nb_round_half(sum.x), nb_round_half(sum.y), nb_round_half(sum.z), nb_round_half(sum.w));
 }
 
+// Same value as nb_neural_level_features (same corner order and rounding), for the fast cooperative-matrix
+// kernels: all 8 corner entries of the level are loaded before any is used, so 8 independent gather
+// loads are in flight per invocation (H200, results/neural/README.md v15: +4 % queries/s; 2 or 4 at a
+// time gained nothing). The scalar kernel keeps the rolled loop above.
+#ifdef NB_COOP_ACC_BITS
+#extension GL_EXT_control_flow_attributes : require
+vec4 nb_neural_level_features_batched(vec3 p, uint l) {
+    GpuHashLevel lv = neural_levels[l];
+    uvec3 cell;
+    vec3 frac;
+    nb_grid_position(lv, p, cell, frac);
+    vec4 sum = vec4(0.0f);
+    // A loop of ONE iteration on purpose: the same code without it (straight-line) ran 0.43 instead of
+    // 0.57 G queries/s (v15 run 2), presumably because the driver then schedules the level loop around it
+    // differently (more registers, fewer resident warps).
+    for (uint c0 = 0u; c0 < NB_GRID_CORNERS; c0 += NB_GRID_CORNERS) {
+        uvec2 e[NB_GRID_CORNERS];
+        [[unroll]] for (uint c = 0u; c < NB_GRID_CORNERS; ++c) e[c] = neural_grid[nb_grid_corner_entry(lv, cell, c0 + c)];
+        [[unroll]] for (uint c = 0u; c < NB_GRID_CORNERS; ++c) {
+            float w = nb_grid_corner_weight(frac, c0 + c);
+            vec4 v = vec4(unpackHalf2x16(e[c].x), unpackHalf2x16(e[c].y));
+            sum.x += w * v.x;
+            sum.y += w * v.y;
+            sum.z += w * v.z;
+            sum.w += w * v.w;
+        }
+    }
+    return vec4(nb_round_half(sum.x), nb_round_half(sum.y), nb_round_half(sum.z), nb_round_half(sum.w));
+}
+#endif
+
 // The 32 features (level-major, 4 per level) of one encoded point.
 void nb_neural_point_features(vec3 p, out float f[NB_POINT_FEATURES]) {
     for (uint l = 0u; l < NB_GRID_MAX_LEVELS; ++l) {

@@ -123,7 +123,11 @@ void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
     for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
         vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
         for (uint l = 0u; l < NB_GRID_MAX_LEVELS; ++l) {
+#if NB_COOP_FAST
+            vec4 v = valid ? nb_neural_level_features_batched(p, l) : vec4(0.0f);
+#else
             vec4 v = valid ? nb_neural_level_features(p, l) : vec4(0.0f);
+#endif
             uint o = base + nb_feature_slot(k, l, 0u);
             nb_sh_x[o] = float16_t(v.x);
             nb_sh_x[o + 1u] = float16_t(v.y);

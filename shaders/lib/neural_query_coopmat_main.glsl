@@ -14,7 +14,9 @@ void main() {
     vec3 p0, p1, p2;
     nb_segment_points(neural_params.box, r.org, r.dir, r.pl.t_enter, r.pl.t_exit, p0, p1, p2);
     nb_coop_stage_features(gl_LocalInvocationID.x, r.valid, p0, p1, p2);
-    barrier();
+    // Each subgroup stages and runs the MLP on only its own 32 rows: with NB_COOP_FAST a subgroup
+    // barrier (shared-memory semantics) lets one subgroup's MLP overlap the other's gather.
+    NB_COOP_SYNC();
     nb_mlp_forward_coopmat(); // whole workgroup, uniform control flow
     if (!r.valid) return;
     float y[NB_MLP_OUTPUTS];
