@@ -8,23 +8,12 @@
 
 #include "engine/neural/batched_network.h"
 #include "engine/neural/reference_network.h"
+#include "tests/neural/test_networks.h"
 
 using namespace nbvh;
 using namespace nbvh::neural;
 
 namespace {
-
-// Values large enough that every layer and the grid matter (tcnn's +-1e-4 grid init would not).
-NetworkWeights big_network(uint64_t seed) {
-    NeuralConfig cfg;
-    cfg.log2_hash_size = 14;
-    NetworkWeights w = create_network(cfg, seed);
-    std::mt19937 rng(uint32_t(seed) + 3u);
-    std::uniform_real_distribution<float> u(-0.5f, 0.5f);
-    for (float& v : w.grid) v = u(rng);
-    for (float& v : w.mlp) v *= 1.5f;
-    return w;
-}
 
 std::vector<SegmentQuery> queries(size_t n, uint32_t seed) {
     std::mt19937 rng(seed);
@@ -103,9 +92,9 @@ void check_against_reference(const NetworkWeights& w, size_t n, uint32_t seed) {
 
 } // namespace
 
-TEST(BatchedNetwork, FullTilesMatchReference) { check_against_reference(big_network(11), 4 * kBatchTile, 11); }
+TEST(BatchedNetwork, FullTilesMatchReference) { check_against_reference(test::large_value_network(11), 4 * kBatchTile, 11); }
 
-TEST(BatchedNetwork, PartialTileMatchesReference) { check_against_reference(big_network(12), kBatchTile + 17, 12); }
+TEST(BatchedNetwork, PartialTileMatchesReference) { check_against_reference(test::large_value_network(12), kBatchTile + 17, 12); }
 
 TEST(BatchedNetwork, TcnnInitMatchesReference) {
     NeuralConfig cfg;
@@ -114,7 +103,7 @@ TEST(BatchedNetwork, TcnnInitMatchesReference) {
 }
 
 TEST(BatchedNetwork, EmptyTileIsANoOp) {
-    const NetworkWeights w = big_network(14);
+    const NetworkWeights w = test::large_value_network(14);
     auto tile = make_batch_tile();
     forward_tile(w, {}, *tile);
     std::vector<float> mlp(NB_MLP_WEIGHT_COUNT, 0.0f), dense(w.grid.size(), 0.0f);

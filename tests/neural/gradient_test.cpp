@@ -10,24 +10,12 @@
 #include "engine/neural/fp16.h"
 #include "engine/neural/losses.h"
 #include "engine/neural/reference_network.h"
+#include "tests/neural/test_networks.h"
 
 using namespace nbvh;
 using namespace nbvh::neural;
 
 namespace {
-
-// A small (T = 14) network with grid values and weights large enough that every layer matters
-// (the tcnn init of +-1e-4 would make grid gradients of later layers vanish in the comparison).
-NetworkWeights test_network(uint64_t seed) {
-    NeuralConfig cfg;
-    cfg.log2_hash_size = 14;
-    NetworkWeights w = create_network(cfg, seed);
-    std::mt19937 rng(uint32_t(seed) + 7u);
-    std::uniform_real_distribution<float> u(-0.5f, 0.5f);
-    for (float& v : w.grid) v = u(rng);
-    for (float& v : w.mlp) v *= 1.5f;
-    return w;
-}
 
 std::vector<SegmentQuery> test_queries(int n, uint32_t seed) {
     std::mt19937 rng(seed);
@@ -61,7 +49,7 @@ struct GradProbe {
 };
 
 GradProbe make_setup(uint64_t seed) {
-    GradProbe s{to_double(test_network(seed)), test_queries(1, uint32_t(seed))[0], {}, {}};
+    GradProbe s{to_double(test::large_value_network(seed)), test_queries(1, uint32_t(seed))[0], {}, {}};
     std::mt19937 rng(uint32_t(seed) * 3u + 1u);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     for (double& v : s.c) v = u(rng);
@@ -159,7 +147,7 @@ TEST(Gradients, FeatureGradientMatchesFiniteDifferencesThroughTheMlp) {
 }
 
 TEST(Gradients, FloatBackwardMatchesDoubleBackward) {
-    const NetworkWeights wf = test_network(5);
+    const NetworkWeights wf = test::large_value_network(5);
     const NetworkWeightsT<double> wd = to_double(wf);
     const SegmentQuery q = test_queries(1, 5)[0];
     Outputs cf{};
@@ -240,7 +228,7 @@ TEST(Forward, Fp16EmulationIsCloseToFp32) {
     for (bool trained_like : {false, true}) {
         NeuralConfig cfg;
         cfg.log2_hash_size = 14;
-        const NetworkWeights w = trained_like ? test_network(6) : create_network(cfg, 6);
+        const NetworkWeights w = trained_like ? test::large_value_network(6) : create_network(cfg, 6);
         double max_diff = 0;
         for (const SegmentQuery& q : test_queries(200, 6)) {
             ForwardCache c16;
@@ -258,7 +246,7 @@ TEST(Forward, Fp16EmulationIsCloseToFp32) {
 }
 
 TEST(Forward, BatchedMatchesSingle) {
-    const NetworkWeights w = test_network(8);
+    const NetworkWeights w = test::large_value_network(8);
     const auto qs = test_queries(300, 8);
     std::vector<Outputs> out(qs.size());
     forward_batch(w, qs, Precision::fp32, out, 3);
