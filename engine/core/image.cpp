@@ -1,5 +1,7 @@
 #include "engine/core/image.h"
 
+#include "shaders/shared/sampling.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -119,9 +121,9 @@ Image::Image(int w, int h, int c, float fill) : width(w), height(h), channels(c)
     data.assign(size_t(w) * size_t(h) * size_t(c), fill);
 }
 
-float srgb_to_linear(float c) {
-    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
+// The GPU's decode (shaders/shared/sampling.h) is the one definition; CPU texture sampling, image loading
+// and FLIP's LDR input all go through it.
+float srgb_to_linear(float c) { return nb_srgb_to_linear(c); }
 
 float linear_to_srgb(float c) {
     return c <= 0.0031308f ? c * 12.92f : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
