@@ -41,6 +41,8 @@ bool has_shape(const vk::DeviceFeatures& dev, VkComponentTypeNV acc) {
 }
 } // namespace
 
+bool has_fp16_accumulate_shape(const vk::DeviceFeatures& dev) { return has_shape(dev, VK_COMPONENT_TYPE_FLOAT16_NV); }
+
 std::string coopmat_unavailable_reason(const vk::DeviceFeatures& dev) {
     if (!dev.coop_matrix_nv) return "the device lacks VK_NV_cooperative_matrix";
     if (!dev.fp16) return "the device lacks shaderFloat16";
@@ -48,6 +50,7 @@ std::string coopmat_unavailable_reason(const vk::DeviceFeatures& dev) {
     if (dev.subgroup_size != NB_NEURAL_COOP_SUBGROUP)
         return strfmt("the cooperative-matrix kernel needs subgroups of %u (device: %u)", NB_NEURAL_COOP_SUBGROUP,
                       dev.subgroup_size);
+    if (!dev.subgroup_shuffle) return "the device lacks subgroup shuffles in compute shaders";
     if (dev.max_shared_memory < 18u * 1024u) return "the device has less than 18 KiB of shared memory";
     if (!has_shape(dev, VK_COMPONENT_TYPE_FLOAT32_NV) && !has_shape(dev, VK_COMPONENT_TYPE_FLOAT16_NV))
         return "the device has no 16x16x16 fp16 cooperative-matrix shape";
@@ -79,7 +82,7 @@ std::vector<uint16_t> transpose_mlp(const std::vector<uint16_t>& mlp) {
     for (uint32_t m = 0; m < NB_MLP_MATRICES; ++m) {
         const uint32_t ins = nb_mlp_layer_inputs(m), outs = nb_mlp_layer_outputs(m), off = nb_mlp_layer_offset(m);
         for (uint32_t r = 0; r < outs; ++r)
-            for (uint32_t c = 0; c < ins; ++c) t[off + c * outs + r] = mlp[nb_mlp_weight_index(m, r, c)];
+            for (uint32_t c = 0; c < ins; ++c) t[off + nb_coop_weight_slot(outs, c, r)] = mlp[nb_mlp_weight_index(m, r, c)];
     }
     return t;
 }

@@ -36,6 +36,8 @@ struct NeuralKernelChoice {
 NeuralKernelChoice choose_neural_kernel(const vk::DeviceFeatures& dev, NeuralPath requested);
 // Why the cooperative-matrix path is unavailable ("" when it is available).
 std::string coopmat_unavailable_reason(const vk::DeviceFeatures& dev);
+// The device has the 16x16x16 fp16 -> fp16 shape (the fp16-accumulator kernel can run).
+bool has_fp16_accumulate_shape(const vk::DeviceFeatures& dev);
 
 // Shader of the fp32-accumulating cooperative-matrix kernel: kind "eval" or "query". It is variant "g"
 // of the kernels measured in results/neural/README.md (v8-v10: MLP loops unrolled, subgroup barriers,
@@ -48,8 +50,9 @@ GpuEncodingBox encoding_box_of(const NeuralModel& model);
 // Nodes of every LoD concatenated; roots[l] = first node of LoD l. Interior refs are offset so each
 // LoD's nodes index the concatenated array; leaf refs keep N-BVH node indices.
 void pack_lod_nodes(const NeuralModel& model, std::vector<GpuBvhNode>& nodes, std::vector<uint32_t>& roots);
-// The weights with every matrix transposed (row-major inputs x outputs, same offsets as mlp.h): the
-// cooperative-matrix kernels load B = W^T tiles as contiguous rows.
+// The weights with every matrix transposed and cut into 16x16 tiles (same matrix offsets as mlp.h;
+// element (input c, output r) at nb_coop_weight_slot): each B = W^T tile the cooperative-matrix kernels
+// load is 512 contiguous bytes.
 std::vector<uint16_t> transpose_mlp(const std::vector<uint16_t>& mlp);
 
 class NeuralModelGpu {

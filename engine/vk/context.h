@@ -88,6 +88,9 @@ struct DeviceFeatures {
     bool coop_matrix_nv = false; // VK_NV_cooperative_matrix
     std::vector<CoopMatrixShape> coop_matrix_shapes;
 
+    bool pipeline_statistics = false; // VK_KHR_pipeline_executable_properties (NBVH_PIPELINE_STATS=1)
+    bool subgroup_shuffle = false;    // subgroupShuffle* in compute shaders
+
     uint32_t subgroup_size = 0;
     uint32_t min_subgroup_size = 0, max_subgroup_size = 0; // equal to subgroup_size without control
     uint32_t max_shared_memory = 0;          // bytes per workgroup

@@ -141,8 +141,11 @@ void Context::create_device(const std::vector<std::string>& extra_extensions) {
     const bool has_ssc = has_extension(exts, VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME);
     const bool has_coop = has_extension(exts, VK_NV_COOPERATIVE_MATRIX_EXTENSION_NAME);
     const bool has_nsi = has_extension(exts, VK_KHR_SHADER_NON_SEMANTIC_INFO_EXTENSION_NAME);
+    const bool has_pep = has_extension(exts, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
 
     // What the device supports.
+    VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR pep{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
     VkPhysicalDeviceCooperativeMatrixFeaturesNV coop{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_COOPERATIVE_MATRIX_FEATURES_NV};
     VkPhysicalDeviceSubgroupSizeControlFeaturesEXT ssc{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT};
@@ -152,6 +155,7 @@ void Context::create_device(const std::vector<std::string>& extra_extensions) {
     void** tail = &f12.pNext;
     if (has_ssc) { *tail = &ssc; tail = &ssc.pNext; }
     if (has_coop) { *tail = &coop; tail = &coop.pNext; }
+    if (has_pep) { *tail = &pep; tail = &pep.pNext; }
     vkGetPhysicalDeviceFeatures2(physical_, &f2);
 
     VkPhysicalDeviceSubgroupSizeControlPropertiesEXT ssc_props{
@@ -185,7 +189,10 @@ void Context::create_device(const std::vector<std::string>& extra_extensions) {
                                    f12.shaderSampledImageArrayNonUniformIndexing;
     d.subgroup_size_control = has_ssc && ssc.subgroupSizeControl && ssc.computeFullSubgroups;
     d.coop_matrix_nv = has_coop && coop.cooperativeMatrix && d.fp16;
+    d.pipeline_statistics = has_pep && pep.pipelineExecutableInfo;
     d.subgroup_size = p11.subgroupSize;
+    d.subgroup_shuffle = (p11.subgroupSupportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+                         (p11.subgroupSupportedOperations & VK_SUBGROUP_FEATURE_SHUFFLE_BIT);
     d.min_subgroup_size = d.subgroup_size_control ? ssc_props.minSubgroupSize : p11.subgroupSize;
     d.max_subgroup_size = d.subgroup_size_control ? ssc_props.maxSubgroupSize : p11.subgroupSize;
     d.max_shared_memory = props.limits.maxComputeSharedMemorySize;
@@ -249,6 +256,14 @@ void Context::create_device(const std::vector<std::string>& extra_extensions) {
         *etail = &coop_on;
         etail = &coop_on.pNext;
         enabled.push_back(VK_NV_COOPERATIVE_MATRIX_EXTENSION_NAME);
+    }
+    VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR pep_on{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+    if (d.pipeline_statistics) {
+        pep_on.pipelineExecutableInfo = VK_TRUE;
+        *etail = &pep_on;
+        etail = &pep_on.pNext;
+        enabled.push_back(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
     }
     if (has_nsi) enabled.push_back(VK_KHR_SHADER_NON_SEMANTIC_INFO_EXTENSION_NAME); // debugPrintf
     for (const std::string& name : extra_extensions) {

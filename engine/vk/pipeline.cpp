@@ -4,6 +4,9 @@
 #include "shaders/shader_registry.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
 #include <utility>
 
 namespace nbvh::vk {
@@ -87,9 +90,53 @@ ComputePipeline::ComputePipeline(const Context& ctx, const PipelineDesc& desc) :
         info.stage.pNext = &subgroup;
     }
     info.layout = layout_;
+    const bool stats = statistics_requested(ctx);
+    if (stats) info.flags |= VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR;
     NBVH_VK_CHECK(vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_));
     vkDestroyShaderModule(dev, module, nullptr);
     ctx.set_name(VK_OBJECT_TYPE_PIPELINE, pipeline_, desc.shader);
+    if (stats) log_statistics(ctx);
+}
+
+bool ComputePipeline::statistics_requested(const Context& ctx) {
+    const char* env = std::getenv("NBVH_PIPELINE_STATS");
+    return env && *env && std::string(env) != "0" && ctx.features().pipeline_statistics;
+}
+
+// The driver's statistics of the compiled pipeline (registers, shared memory, instruction counts: whatever
+// the driver reports), one line per executable on stderr. A benchmarking aid: NBVH_PIPELINE_STATS=1.
+void ComputePipeline::log_statistics(const Context& ctx) const {
+    VkDevice dev = ctx.device();
+    auto get_execs = (PFN_vkGetPipelineExecutablePropertiesKHR)vkGetDeviceProcAddr(
+        dev, "vkGetPipelineExecutablePropertiesKHR");
+    auto get_stats = (PFN_vkGetPipelineExecutableStatisticsKHR)vkGetDeviceProcAddr(
+        dev, "vkGetPipelineExecutableStatisticsKHR");
+    if (!get_execs || !get_stats) return;
+    VkPipelineInfoKHR pinfo{VK_STRUCTURE_TYPE_PIPELINE_INFO_KHR};
+    pinfo.pipeline = pipeline_;
+    uint32_t n = 0;
+    if (get_execs(dev, &pinfo, &n, nullptr) != VK_SUCCESS) return;
+    for (uint32_t e = 0; e < n; ++e) {
+        VkPipelineExecutableInfoKHR einfo{VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_INFO_KHR};
+        einfo.pipeline = pipeline_;
+        einfo.executableIndex = e;
+        uint32_t m = 0;
+        if (get_stats(dev, &einfo, &m, nullptr) != VK_SUCCESS) continue;
+        std::vector<VkPipelineExecutableStatisticKHR> st(m, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR});
+        if (get_stats(dev, &einfo, &m, st.data()) != VK_SUCCESS) continue;
+        std::string line = "pipeline statistics " + desc_.shader + ":";
+        for (const VkPipelineExecutableStatisticKHR& x : st) {
+            line += strfmt(" %s=", x.name);
+            switch (x.format) {
+            case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_BOOL32_KHR: line += x.value.b32 ? "true" : "false"; break;
+            case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_INT64_KHR: line += strfmt("%lld", (long long)x.value.i64); break;
+            case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_UINT64_KHR: line += strfmt("%llu", (unsigned long long)x.value.u64); break;
+            case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_FLOAT64_KHR: line += strfmt("%g", x.value.f64); break;
+            default: line += "?"; break;
+            }
+        }
+        std::fprintf(stderr, "%s\n", line.c_str());
+    }
 }
 
 ComputePipeline::~ComputePipeline() { destroy(); }

@@ -58,6 +58,8 @@ public:
 
 private:
     void destroy();
+    static bool statistics_requested(const Context& ctx);
+    void log_statistics(const Context& ctx) const;
     const Context* ctx_ = nullptr;
     PipelineDesc desc_;
     VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;

@@ -26,8 +26,11 @@ void main() {
     vec3 p0, p1, p2;
     nb_segment_points(pc.box, q.origin, q.dir, q.t_entry, q.t_exit, p0, p1, p2);
     if (NB_EVAL_PART == 2u) {
-        for (uint f = 0u; f < NB_MLP_INPUTS; ++f)
-            nb_sh_x[local * NB_COOP_STRIDE + f] = float16_t(float((i * 7u + f) & 15u) * (1.0f / 16.0f) + p0.x);
+        for (uint f = 0u; f < NB_MLP_INPUTS; f += 4u) {
+            vec4 v;
+            for (uint c = 0u; c < 4u; ++c) v[c] = float(((i * 7u + f + c) & 15u)) * (1.0f / 16.0f) + p0.x;
+            nb_coop_x_write4(local, f, vec4(unpackHalf2x16(packHalf2x16(v.xy)), unpackHalf2x16(packHalf2x16(v.zw))));
+        }
     } else {
         nb_coop_stage_features(local, valid, p0, p1, p2);
     }
@@ -38,8 +41,7 @@ void main() {
     if (!valid) return;
     float y[NB_MLP_OUTPUTS];
     for (uint r = 0u; r < NB_MLP_OUTPUTS; ++r) {
-        float pre = NB_EVAL_PART == 1u ? float(nb_sh_x[local * NB_COOP_STRIDE + r * 12u])
-                                       : nb_sh_y[local * NB_MLP_OUTPUTS_PADDED + r];
+        float pre = NB_EVAL_PART == 1u ? nb_coop_x_read(local, r * 12u) : nb_sh_y[local * NB_COOP_Y_STRIDE + r];
         y[r] = nb_sigmoid(pre);
     }
     hits[i] = nb_neural_decode(pc.box, y, q.t_entry, q.t_exit, pc.threshold);

@@ -37,34 +37,63 @@ vec4 nb_neural_level_features(vec3 p, uint l) {
     return vec4(nb_round_half(sum.x), nb_round_half(sum.y), nb_round_half(sum.z), nb_round_half(sum.w));
 }
 
-// Same value as nb_neural_level_features (same corner order and rounding), for the fast cooperative-matrix
-// kernels: all 8 corner entries of the level are loaded before any is used, so 8 independent gather
-// loads are in flight per invocation (H200, results/neural/README.md v15: +4 % queries/s; 2 or 4 at a
-// time gained nothing). The scalar kernel keeps the rolled loop above.
+// Fast gather of the fp32 cooperative-matrix kernel (NB_COOP_ACC_BITS defined; subgroups of 32, checked
+// on the host). It fetches NB_GATHER_LEVELS levels of a point at once, so that 8 * NB_GATHER_LEVELS
+// independent loads are in flight per invocation: the fused kernel's registers are set by the MLP
+// (168 per invocation on the H200, 12 warps per SM), which leaves the gather phase room for many loads
+// in flight, and that phase has to hide the gather latency with few resident warps (v17: 1 -> 2 -> 4
+// levels at once, 0.81 -> 0.87 -> 0.88 G queries/s random, 0.99 -> 1.05 -> 1.12 coherent).
 #ifdef NB_COOP_ACC_BITS
 #extension GL_EXT_control_flow_attributes : require
-vec4 nb_neural_level_features_batched(vec3 p, uint l) {
-    GpuHashLevel lv = neural_levels[l];
-    uvec3 cell;
-    vec3 frac;
-    nb_grid_position(lv, p, cell, frac);
-    vec4 sum = vec4(0.0f);
+#extension GL_KHR_shader_subgroup_shuffle : require
+#ifndef NB_GATHER_LEVELS
+#define NB_GATHER_LEVELS 4u
+#endif
+
+// Paired-lane gather: the 2 lanes of a pair (lane ^ 1) look up BOTH their queries' levels together:
+// the even lane loads the corners with x bit 0 (0, 2, 4, 6), the odd lane those with x bit 1 (1, 3, 5,
+// 7). Corners c and c|1 differ only in x, and both index schemes (dense x + ..., CoherentPrime x * 1 ^
+// ...) keep them in the same 128-byte line 15 times out of 16, so one load instruction of the subgroup
+// touches ~16 lines instead of 32: random gathers are bound by L1 requests (lines), which this halves
+// (H200, results/neural v17: gather alone 0.84 -> 1.15 G/s). Each lane sums its 4 corners per query in
+// corner order (fp32); the pair swaps the partial sums of each other's query; a level's feature =
+// sum(even corners) + sum(odd corners), rounded once to fp16 (R1). That order differs from the
+// reference's 0..7 chain, so a feature can differ by one fp16 ulp from the CPU reference (the coopmat
+// MLP sums in another order too; tests/neuralvk bounds both). All 32 lanes must be active (shuffles).
+void nb_neural_levels_paired(vec3 p_even, vec3 p_odd, uint l0, uint xbit, out vec4 f[NB_GATHER_LEVELS]) {
     // A loop of ONE iteration on purpose: the same code without it (straight-line) ran 0.43 instead of
-    // 0.57 G queries/s (v15 run 2), presumably because the driver then schedules the level loop around it
-    // differently (more registers, fewer resident warps).
-    for (uint c0 = 0u; c0 < NB_GRID_CORNERS; c0 += NB_GRID_CORNERS) {
-        uvec2 e[NB_GRID_CORNERS];
-        [[unroll]] for (uint c = 0u; c < NB_GRID_CORNERS; ++c) e[c] = neural_grid[nb_grid_corner_entry(lv, cell, c0 + c)];
-        [[unroll]] for (uint c = 0u; c < NB_GRID_CORNERS; ++c) {
-            float w = nb_grid_corner_weight(frac, c0 + c);
-            vec4 v = vec4(unpackHalf2x16(e[c].x), unpackHalf2x16(e[c].y));
-            sum.x += w * v.x;
-            sum.y += w * v.y;
-            sum.z += w * v.z;
-            sum.w += w * v.w;
+    // 0.57 G queries/s in the v15 kernel (results/neural/README.md), presumably because the driver then
+    // schedules the level loop around it differently (more registers, fewer resident warps).
+    for (uint once = 0u; once < 1u; ++once) {
+        uvec2 ea[NB_GATHER_LEVELS * 4u];
+        uvec2 eb[NB_GATHER_LEVELS * 4u];
+        vec3 fa[NB_GATHER_LEVELS];
+        vec3 fb[NB_GATHER_LEVELS];
+        [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g) {
+            GpuHashLevel lv = neural_levels[l0 + g];
+            uvec3 ca, cb;
+            nb_grid_position(lv, p_even, ca, fa[g]);
+            nb_grid_position(lv, p_odd, cb, fb[g]);
+            [[unroll]] for (uint j = 0u; j < 4u; ++j) {
+                ea[g * 4u + j] = neural_grid[nb_grid_corner_entry(lv, ca, 2u * j + xbit)];
+                eb[g * 4u + j] = neural_grid[nb_grid_corner_entry(lv, cb, 2u * j + xbit)];
+            }
+        }
+        [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g) {
+            vec4 sa = vec4(0.0f);
+            vec4 sb = vec4(0.0f);
+            [[unroll]] for (uint j = 0u; j < 4u; ++j) {
+                uvec2 xa = ea[g * 4u + j];
+                uvec2 xb = eb[g * 4u + j];
+                sa += nb_grid_corner_weight(fa[g], 2u * j + xbit) * vec4(unpackHalf2x16(xa.x), unpackHalf2x16(xa.y));
+                sb += nb_grid_corner_weight(fb[g], 2u * j + xbit) * vec4(unpackHalf2x16(xb.x), unpackHalf2x16(xb.y));
+            }
+            // The even lane owns query a, the odd lane query b: each sends the partial of its partner's query.
+            vec4 other = subgroupShuffleXor(xbit == 0u ? sb : sa, 1u);
+            vec4 sum = (xbit == 0u ? sa : sb) + other; // even + odd in both lanes (addition commutes exactly)
+            f[g] = vec4(nb_round_half(sum.x), nb_round_half(sum.y), nb_round_half(sum.z), nb_round_half(sum.w));
         }
     }
-    return vec4(nb_round_half(sum.x), nb_round_half(sum.y), nb_round_half(sum.z), nb_round_half(sum.w));
 }
 #endif
 

@@ -3,18 +3,19 @@
 // rows (queries) of the activation matrices. Features and activations stay in shared memory
 // (on chip) between layers; weights are read as 16x16 fp16 tiles straight from the storage buffer
 // (38 KiB, L1/L2 resident), each B tile once per subgroup and layer, from a copy with every matrix
-// transposed (engine/render/neural_model_gpu.h transpose_mlp) so B = W^T tiles are contiguous rows.
+// transposed and tiled (engine/render/neural_model_gpu.h transpose_mlp, shared/mlp.h
+// nb_coop_weight_slot) so each B = W^T tile is 512 contiguous bytes (4 cache lines, not 16).
 // Per layer: H_out(32 x 64) = relu(H_in(32 x K) * W^T(K x 64)), K = 96 or 64,
 // 16x16x16 tiles, accumulators fp32 (NB_COOP_ACC_BITS 32, rounding points of mlp.h R3/R4 with a
 // different summation order) or fp16 (16, for devices without fp32 accumulation).
-// Shared memory: 64x104 halves (in place for every layer) + 64x16 floats = 17 KiB (48 KiB on NVIDIA).
+// Shared memory: 64x104 halves (in place for every layer) + 64x20 floats = 18 KiB (48 KiB on NVIDIA).
 //
 // Only compiled into passes that are created on devices with VK_NV_cooperative_matrix, 16x16x16 fp16
 // shapes and subgroup size 32 (engine/render/neural_model_gpu.cpp checks). The including shader
 // declares `float16_t neural_mlp_h[];` (the TRANSPOSED weight buffer seen as halves), defines NB_COOP_ACC_BITS,
-// fills nb_sh_x (query row r at r*96, features in mlp.h input order) and calls
+// fills nb_sh_x (query row r, features in mlp.h input order: nb_coop_x_write4) and calls
 // nb_mlp_forward_coopmat() from uniform control flow; outputs (after the sigmoid) are then in
-// nb_sh_y[r*16 + 0..7].
+// nb_sh_y[r*NB_COOP_Y_STRIDE + 0..7].
 #ifndef NB_NEURAL_MLP_COOPMAT_GLSL
 #define NB_NEURAL_MLP_COOPMAT_GLSL
 #extension GL_NV_cooperative_matrix : require
@@ -35,12 +36,21 @@
 // 16 bytes (cooperative-matrix loads) that spreads the per-invocation feature stores over 8 banks
 // instead of 2.
 #define NB_COOP_STRIDE 104u
+// The activation buffer is an array of uvec2 (4 halves): the staging writes a level's 4 features with
+// one 64-bit store (16-bit stores at this stride conflict 4-way on the banks); cooperative-matrix
+// loads and stores address it in units of uvec2 (offsets and strides / 4).
+#define NB_COOP_STRIDE_V (NB_COOP_STRIDE / 4u)
+// Row stride of the fp32 output buffer: 20 floats instead of 16, so reading a row's 8 outputs
+// conflicts 4-way instead of 16-way (80 bytes, still a multiple of 16 for coopMatStoreNV).
+#define NB_COOP_Y_STRIDE 20u
 
 // NB_COOP_FAST (defined by the including pass; H200 figures in results/neural/README.md v8-v10):
 // NB_COOP_FAST 1: every MLP loop fully unrolled (no dynamically indexed cooperative-matrix arrays or
 // elements) and only subgroup barriers inside the MLP (each subgroup reads and writes only its own 32
-// rows, so no other subgroup has to wait): MLP alone 0.63 -> 1.77 G queries/s. The fp16-accumulator
-// kernel (coop16, no GPU here to re-measure it) keeps the earlier looped form (0).
+// rows, so no other subgroup has to wait): MLP alone 0.63 -> 1.77 G queries/s; and the paired-lane
+// gather of lib/neural_grid.glsl, NB_GATHER_LEVELS levels at a time (v17). The fp16-accumulator
+// kernel (coop16, for devices without fp32 accumulation) keeps the earlier looped form (0) and the
+// one-query-per-lane gather. Both read the tiled weights (MLP alone 1.77 -> 3.14 G/s, v17).
 #ifndef NB_COOP_FAST
 #define NB_COOP_FAST 0
 #endif
@@ -54,24 +64,34 @@
 
 // Layer inputs and outputs, in place: each layer loads its whole input tile set into accumulators
 // before any output is stored (a barrier separates the two), so one buffer serves all layers.
-shared float16_t nb_sh_x[NB_NEURAL_GROUP * NB_COOP_STRIDE];
-shared float nb_sh_y[NB_NEURAL_GROUP * NB_MLP_OUTPUTS_PADDED];
+shared uvec2 nb_sh_x[NB_NEURAL_GROUP * NB_COOP_STRIDE_V];
+shared float nb_sh_y[NB_NEURAL_GROUP * NB_COOP_Y_STRIDE];
+
+// Features f0..f0+3 (f0 a multiple of 4) of row `row`, already rounded to fp16 (exact when packed).
+void nb_coop_x_write4(uint row, uint f0, vec4 v) {
+    nb_sh_x[row * NB_COOP_STRIDE_V + f0 / 4u] = uvec2(packHalf2x16(v.xy), packHalf2x16(v.zw));
+}
+float nb_coop_x_read(uint row, uint f) {
+    uvec2 e = nb_sh_x[row * NB_COOP_STRIDE_V + f / 4u];
+    vec2 h = unpackHalf2x16((f & 2u) != 0u ? e.y : e.x);
+    return (f & 1u) != 0u ? h.y : h.x;
+}
 
 #define NB_FCM(BITS) fcoopmatNV<BITS, gl_ScopeSubgroup, 16, 16>
 
 // One hidden layer for the 32 rows of this subgroup: X[:, 0:64] = half(relu(X[:, 0:K] * W_m^T)).
-#define NB_COOP_HIDDEN_LAYER(K, WBUF, WOFF, WSTRIDE)                                                                    \
+#define NB_COOP_HIDDEN_LAYER(K, WBUF, WOFF, WOUTS)                                                                      \
     {                                                                                                 \
         NB_FCM(NB_COOP_ACC_BITS) acc[8];                                                              \
         NB_UNROLL for (uint j = 0u; j < 8u; ++j) acc[j] = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));             \
         NB_UNROLL for (uint kt = 0u; kt < (K) / 16u; ++kt) {                                          \
             NB_FCM(16) a0;                                                                            \
             NB_FCM(16) a1;                                                                            \
-            coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE + kt * 16u, NB_COOP_STRIDE, false);     \
-            coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE + kt * 16u, NB_COOP_STRIDE, false); \
+            coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 4u, NB_COOP_STRIDE_V, false);   \
+            coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 4u, NB_COOP_STRIDE_V, false); \
             NB_UNROLL for (uint nt = 0u; nt < 4u; ++nt) {                                             \
                 NB_FCM(16) b;                                                                         \
-                coopMatLoadNV(b, WBUF, (WOFF) + kt * 16u * (WSTRIDE) + nt * 16u, (WSTRIDE), false);        \
+                coopMatLoadNV(b, WBUF, (WOFF) + nb_coop_weight_slot(WOUTS, kt * 16u, nt * 16u), 16u, false); \
                 acc[nt] = coopMatMulAddNV(a0, b, acc[nt]);                                            \
                 acc[4u + nt] = coopMatMulAddNV(a1, b, acc[4u + nt]);                                  \
             }                                                                                         \
@@ -81,11 +101,10 @@ shared float nb_sh_y[NB_NEURAL_GROUP * NB_MLP_OUTPUTS_PADDED];
             NB_UNROLL for (int e = 0; e < acc[j].length(); ++e) acc[j][e] = max(acc[j][e], NB_ACC_T(0.0));      \
             NB_FCM(16) o = NB_FCM(16)(acc[j]);                                                        \
             uint r = row0 + (j >> 2u) * 16u;                                                          \
-            coopMatStoreNV(o, nb_sh_x, r * NB_COOP_STRIDE + (j & 3u) * 16u, NB_COOP_STRIDE, false);  \
+            coopMatStoreNV(o, nb_sh_x, r * NB_COOP_STRIDE_V + (j & 3u) * 4u, NB_COOP_STRIDE_V, false); \
         }                                                                                             \
         NB_COOP_SYNC();                                                                               \
     }
-
 
 void nb_mlp_forward_coopmat() {
     uint row0 = (gl_LocalInvocationID.x / NB_COOP_ROWS) * NB_COOP_ROWS;
@@ -99,19 +118,20 @@ void nb_mlp_forward_coopmat() {
         NB_FCM(NB_COOP_ACC_BITS) acc1 = acc0;
         NB_UNROLL for (uint kt = 0u; kt < NB_MLP_WIDTH / 16u; ++kt) {
             NB_FCM(16) b;
-            coopMatLoadNV(b, neural_mlp_h, nb_mlp_layer_offset(NB_MLP_HIDDEN_LAYERS) + kt * 16u * NB_MLP_OUTPUTS_PADDED,
-                          NB_MLP_OUTPUTS_PADDED, false);
+            coopMatLoadNV(b, neural_mlp_h,
+                          nb_mlp_layer_offset(NB_MLP_HIDDEN_LAYERS) + nb_coop_weight_slot(NB_MLP_OUTPUTS_PADDED, kt * 16u, 0u),
+                          16u, false);
             NB_FCM(16) a0;
             NB_FCM(16) a1;
-            coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE + kt * 16u, NB_COOP_STRIDE, false);
-            coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE + kt * 16u, NB_COOP_STRIDE, false);
+            coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 4u, NB_COOP_STRIDE_V, false);
+            coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 4u, NB_COOP_STRIDE_V, false);
             acc0 = coopMatMulAddNV(a0, b, acc0);
             acc1 = coopMatMulAddNV(a1, b, acc1);
         }
         NB_FCM(32) y0 = NB_FCM(32)(acc0);
         NB_FCM(32) y1 = NB_FCM(32)(acc1);
-        coopMatStoreNV(y0, nb_sh_y, row0 * NB_MLP_OUTPUTS_PADDED, NB_MLP_OUTPUTS_PADDED, false);
-        coopMatStoreNV(y1, nb_sh_y, (row0 + 16u) * NB_MLP_OUTPUTS_PADDED, NB_MLP_OUTPUTS_PADDED, false);
+        coopMatStoreNV(y0, nb_sh_y, row0 * NB_COOP_Y_STRIDE, NB_COOP_Y_STRIDE, false);
+        coopMatStoreNV(y1, nb_sh_y, (row0 + 16u) * NB_COOP_Y_STRIDE, NB_COOP_Y_STRIDE, false);
     }
     NB_COOP_SYNC();
 }
@@ -119,22 +139,27 @@ void nb_mlp_forward_coopmat() {
 // Writes one query's 96 features (rounded to fp16, R1) into its row of nb_sh_x, level by level (no
 // per-point array stays live); zeros when !valid.
 void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
-    uint base = local * NB_COOP_STRIDE;
+#if NB_COOP_FAST
+    uint xbit = gl_SubgroupInvocationID & 1u;
     for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
         vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
-        for (uint l = 0u; l < NB_GRID_MAX_LEVELS; ++l) {
-#if NB_COOP_FAST
-            vec4 v = valid ? nb_neural_level_features_batched(p, l) : vec4(0.0f);
-#else
-            vec4 v = valid ? nb_neural_level_features(p, l) : vec4(0.0f);
-#endif
-            uint o = base + nb_feature_slot(k, l, 0u);
-            nb_sh_x[o] = float16_t(v.x);
-            nb_sh_x[o + 1u] = float16_t(v.y);
-            nb_sh_x[o + 2u] = float16_t(v.z);
-            nb_sh_x[o + 3u] = float16_t(v.w);
+        vec3 partner = subgroupShuffleXor(p, 1u);
+        vec3 p_even = xbit == 0u ? p : partner;
+        vec3 p_odd = xbit == 0u ? partner : p;
+        for (uint l0 = 0u; l0 < NB_GRID_MAX_LEVELS; l0 += NB_GATHER_LEVELS) {
+            vec4 f[NB_GATHER_LEVELS];
+            nb_neural_levels_paired(p_even, p_odd, l0, xbit, f);
+            [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g)
+                nb_coop_x_write4(local, nb_feature_slot(k, l0 + g, 0u), valid ? f[g] : vec4(0.0f));
         }
     }
+#else
+    for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
+        vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
+        for (uint l = 0u; l < NB_GRID_MAX_LEVELS; ++l)
+            nb_coop_x_write4(local, nb_feature_slot(k, l, 0u), valid ? nb_neural_level_features(p, l) : vec4(0.0f));
+    }
+#endif
 }
 
 #endif

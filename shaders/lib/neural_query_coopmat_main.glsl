@@ -21,6 +21,6 @@ void main() {
     if (!r.valid) return;
     float y[NB_MLP_OUTPUTS];
     for (uint k = 0u; k < NB_MLP_OUTPUTS; ++k)
-        y[k] = nb_sigmoid(nb_sh_y[gl_LocalInvocationID.x * NB_MLP_OUTPUTS_PADDED + k]);
+        y[k] = nb_sigmoid(nb_sh_y[gl_LocalInvocationID.x * NB_COOP_Y_STRIDE + k]);
     nb_apply_neural_result(r, y);
 }

@@ -51,6 +51,14 @@ NB_FN uint nb_mlp_weight_index(uint m, uint row, uint col) {
     return nb_mlp_layer_offset(m) + row * nb_mlp_layer_inputs(m) + col;
 }
 
+// Layout of the cooperative-matrix kernels' weight copy (engine/render/neural_model_gpu.h transpose_mlp):
+// each matrix transposed (inputs x outputs) and stored as 16x16 tiles, tile (c/16, r/16) row-major
+// among the outputs/16 tiles of a tile row, each tile row-major with stride 16. Slot of (input c,
+// output r) relative to the matrix offset; `outs` = the matrix's outputs (64 or 16).
+NB_FN uint nb_coop_weight_slot(uint outs, uint c, uint r) {
+    return ((c / 16u) * (outs / 16u) + r / 16u) * 256u + (c % 16u) * 16u + (r % 16u);
+}
+
 NB_FN float nb_relu(float x) { return max(x, 0.0f); }
 
 // Logistic sigmoid, overflow-safe for any finite x (exp of a non-positive argument only).

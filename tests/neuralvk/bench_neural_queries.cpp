@@ -118,8 +118,16 @@ int main(int argc, char** argv) try {
     const std::string why = coopmat_unavailable_reason(dev);
     if (why.empty()) paths.push_back(NeuralPath::coopmat);
     else std::printf("cooperative-matrix path unavailable: %s\n", why.c_str());
-    for (NeuralPath p : paths) {
-        NeuralEvaluator ev(ctx, gpu, choose_neural_kernel(dev, p));
+    std::vector<NeuralKernelChoice> choices;
+    for (NeuralPath p : paths) choices.push_back(choose_neural_kernel(dev, p));
+    // Where the device has both, the fp16-accumulator kernel too (the fallback of devices without fp32
+    // accumulation), so that it is checked on real hardware.
+    if (why.empty() && choices.back().fp32_accumulate && has_fp16_accumulate_shape(dev)) {
+        choices.push_back(choices.back());
+        choices.back().fp32_accumulate = false;
+    }
+    for (const NeuralKernelChoice& choice : choices) {
+        NeuralEvaluator ev(ctx, gpu, choice);
         Row r;
         r.path = ev.choice().describe();
         r.hits = ev.evaluate(qs); // also warms up
@@ -140,13 +148,13 @@ int main(int argc, char** argv) try {
         std::printf("coopmat breakdown: hash-grid features only %.3f ms (%.3f G/s), MLP only %.3f ms (%.3f G/s)\n",
                     ms_features, qs.size() / (ms_features * 1e6), ms_mlp, qs.size() / (ms_mlp * 1e6));
     }
-    std::string agree = "{}";
-    if (rows.size() == 2) {
+    std::string agree = "[";
+    for (size_t k = 1; k < rows.size(); ++k) {
         double max_dy = 0, sum_dy = 0;
         size_t vis_diff = 0, vis_diff_outside_margin = 0, nonfinite = 0;
         for (size_t i = 0; i < qs.size(); ++i) {
             const GpuNeuralHit& a = rows[0].hits[i];
-            const GpuNeuralHit& b = rows[1].hits[i];
+            const GpuNeuralHit& b = rows[k].hits[i];
             if (!std::isfinite(b.visibility) || !std::isfinite(b.t) || !std::isfinite(b.normal.x)) ++nonfinite;
             double d = std::max({std::abs(a.visibility - b.visibility), std::abs(a.depth - b.depth),
                                  std::abs(a.albedo.x - b.albedo.x), std::abs(a.albedo.y - b.albedo.y),
@@ -158,16 +166,19 @@ int main(int argc, char** argv) try {
                 if (std::abs(a.visibility - NB_VISIBILITY_THRESHOLD) > 2e-3f) ++vis_diff_outside_margin;
             }
         }
-        std::printf("scalar vs coopmat: max |dy| %.3g, mean |dy| %.3g, visibility differs on %zu of %zu (%zu with "
+        const char* label = k == 1 ? "coopmat" : "coopmat fp16-acc";
+        std::printf("scalar vs %s: max |dy| %.3g, mean |dy| %.3g, visibility differs on %zu of %zu (%zu with "
                     "|y0 - 0.5| > 2e-3), non-finite coopmat outputs %zu\n",
-                    max_dy, sum_dy / double(qs.size()), vis_diff, qs.size(), vis_diff_outside_margin, nonfinite);
+                    label, max_dy, sum_dy / double(qs.size()), vis_diff, qs.size(), vis_diff_outside_margin, nonfinite);
         char buf[512];
         std::snprintf(buf, sizeof buf,
-                      "{\"max_abs_dy\": %.6g, \"mean_abs_dy\": %.6g, \"visibility_differs\": %zu, "
+                      "%s{\"path\": \"%s\", \"max_abs_dy\": %.6g, \"mean_abs_dy\": %.6g, \"visibility_differs\": %zu, "
                       "\"visibility_differs_outside_2e-3\": %zu, \"nonfinite\": %zu}",
-                      max_dy, sum_dy / double(qs.size()), vis_diff, vis_diff_outside_margin, nonfinite);
-        agree = buf;
+                      k > 1 ? ", " : "", rows[k].path.c_str(), max_dy, sum_dy / double(qs.size()), vis_diff,
+                      vis_diff_outside_margin, nonfinite);
+        agree += buf;
     }
+    agree += "]";
     if (!json_path.empty()) {
         std::ofstream f(json_path);
         f << "{\n  \"device\": \"" << dev.device_name << "\",\n  \"driver\": \"" << dev.driver_name << " "

@@ -16,6 +16,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <random>
 
@@ -139,5 +141,13 @@ TEST(NeuralPath, TransposedWeightsForCooperativeMatrices) {
     for (uint32_t m = 0; m < NB_MLP_MATRICES; ++m)
         for (uint32_t r : {0u, 5u, nb_mlp_layer_outputs(m) - 1u})
             for (uint32_t c : {0u, 17u, nb_mlp_layer_inputs(m) - 1u})
-                EXPECT_EQ(t[nb_mlp_layer_offset(m) + c * nb_mlp_layer_outputs(m) + r], w[nb_mlp_weight_index(m, r, c)]);
+                EXPECT_EQ(t[nb_mlp_layer_offset(m) + nb_coop_weight_slot(nb_mlp_layer_outputs(m), c, r)],
+                          w[nb_mlp_weight_index(m, r, c)]);
+    // The tiling is a permutation of each matrix: every slot written exactly once.
+    std::vector<int> hits(w.size(), 0);
+    for (uint32_t m = 0; m < NB_MLP_MATRICES; ++m)
+        for (uint32_t r = 0; r < nb_mlp_layer_outputs(m); ++r)
+            for (uint32_t c = 0; c < nb_mlp_layer_inputs(m); ++c)
+                ++hits[nb_mlp_layer_offset(m) + nb_coop_weight_slot(nb_mlp_layer_outputs(m), c, r)];
+    EXPECT_EQ(std::count(hits.begin(), hits.end(), 1), std::ptrdiff_t(hits.size()));
 }
