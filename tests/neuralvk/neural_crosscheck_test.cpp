@@ -17,9 +17,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-
-#include <cmath>
-#include <random>
+#include <cstdio>
 
 using namespace nbvh;
 using namespace nbvh::render;
@@ -34,29 +32,6 @@ vk::Context make_lavapipe() {
     o.device = vk::DeviceChoice::cpu;
     o.validation = true;
     return vk::Context(o);
-}
-
-// Random rays through random sub-boxes (leaves) of the asset box; a quarter start inside their leaf.
-std::vector<GpuNeuralQuery> random_queries(uint64_t seed, size_t n, glm::vec3 lo, glm::vec3 hi) {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    std::vector<GpuNeuralQuery> out;
-    while (out.size() < n) {
-        glm::vec3 a = lo + (hi - lo) * glm::vec3(u(rng), u(rng), u(rng));
-        glm::vec3 b = lo + (hi - lo) * glm::vec3(u(rng), u(rng), u(rng));
-        glm::vec3 llo = glm::min(a, b), lhi = glm::max(a, b);
-        glm::vec3 target = llo + (lhi - llo) * glm::vec3(u(rng), u(rng), u(rng));
-        glm::vec3 dir = glm::normalize(glm::vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f) + 1e-6f);
-        const bool inside = out.size() % 4 == 0;
-        glm::vec3 org = inside ? target : target - dir * (0.5f + 3.0f * u(rng));
-        GpuNeuralQuery q;
-        q.origin = org;
-        q.dir = dir;
-        if (!nb_neural_leaf_interval(org, nb_safe_inv_dir(dir), llo, lhi, q.t_entry, q.t_exit)) continue;
-        if (q.t_exit <= 0.0f) continue;
-        out.push_back(q);
-    }
-    return out;
 }
 
 } // namespace
@@ -85,52 +60,23 @@ TEST(NeuralCrossCheck, ScalarKernelMatchesFp16Reference) {
     const test::TestModel tm = test::make_test_model(7, lo, hi);
     NeuralModelGpu gpu(ctx, tm.model);
     NeuralEvaluator eval(ctx, gpu, choose_neural_kernel(ctx.features(), NeuralPath::scalar));
-    const std::vector<GpuNeuralQuery> qs = random_queries(11, 3000, lo, hi);
+    const std::vector<GpuNeuralQuery> qs = test::random_queries(11, 3000, lo, hi);
     const std::vector<GpuNeuralHit> hits = eval.evaluate(qs);
     ASSERT_EQ(hits.size(), qs.size());
-
-    float max_out = 0.0f, max_t = 0.0f, max_n = 0.0f;
-    int decisions = 0, near_threshold = 0, visible = 0, reversed = 0;
-    for (size_t i = 0; i < qs.size(); ++i) {
-        const neural::Outputs y = test::reference_outputs(tm, qs[i]);
-        const GpuNeuralHit& h = hits[i];
-        ASSERT_TRUE(std::isfinite(h.visibility) && std::isfinite(h.depth) && std::isfinite(h.t)) << i;
-        max_out = std::max({max_out, std::abs(h.visibility - y[NB_OUT_VISIBILITY]), std::abs(h.depth - y[NB_OUT_DEPTH])});
-        for (int k = 0; k < 3; ++k) max_out = std::max(max_out, std::abs(h.albedo[k] - y[NB_OUT_ALBEDO + k]));
-        // Decisions.
-        const bool ref_vis = nb_decode_visibility(y[NB_OUT_VISIBILITY], NB_VISIBILITY_THRESHOLD);
-        if (std::abs(y[NB_OUT_VISIBILITY] - NB_VISIBILITY_THRESHOLD) < VIS_MARGIN) {
-            ++near_threshold;
-        } else {
-            ++decisions;
-            EXPECT_EQ((h.flags & NB_NEURAL_VISIBLE) != 0, ref_vis) << "query " << i << " y0 " << y[0];
-        }
-        visible += ref_vis;
-        float t_ref;
-        const bool acc_ref = nb_decode_depth(tm.box, y[NB_OUT_DEPTH], qs[i].t_entry, qs[i].t_exit, t_ref);
-        reversed += nb_query_reversed(qs[i].t_entry);
-        const float len = std::max(qs[i].t_exit - qs[i].t_entry, 0.0f) + tm.box.depth_pad;
-        const float t_err = std::abs(h.t - t_ref) / len;
-        max_t = std::max(max_t, t_err);
-        EXPECT_LE(t_err, OUT_TOL) << "query " << i;
-        if (std::abs(t_ref - qs[i].t_exit + NB_DEPTH_EPSILON * (len - tm.box.depth_pad) + tm.box.fixed_depth_eps) >
-            OUT_TOL * len)
-            EXPECT_EQ((h.flags & NB_NEURAL_ACCEPTED) != 0, acc_ref) << "query " << i;
-        const glm::vec3 nraw(2 * y[2] - 1, 2 * y[3] - 1, 2 * y[4] - 1);
-        if (glm::length(nraw) > 0.05f) {
-            const glm::vec3 n_ref = nb_decode_normal(y[2], y[3], y[4]);
-            max_n = std::max(max_n, glm::length(h.normal - n_ref));
-        }
-    }
+    const test::CrossCheck c = test::cross_check(tm, qs, hits, VIS_MARGIN);
     std::printf("scalar vs fp16 reference over %zu queries (%d reversed): max |dy| %.3g, max |dt|/L %.3g, "
                 "max |dn| %.3g; %d decisions (%d visible), %d near the threshold\n",
-                qs.size(), reversed, max_out, max_t, max_n, decisions, visible, near_threshold);
-    EXPECT_LE(max_out, OUT_TOL);
-    EXPECT_LE(max_n, 0.01f);
+                qs.size(), c.reversed, c.max_out, c.max_t, c.max_n, c.decisions, c.visible, c.near_threshold);
+    EXPECT_EQ(c.non_finite, 0);
+    EXPECT_LE(c.max_out, OUT_TOL);
+    EXPECT_LE(c.max_t, OUT_TOL);
+    EXPECT_LE(c.max_n, 0.01f);
+    EXPECT_EQ(c.decision_errors, 0);
+    EXPECT_EQ(c.acceptance_errors, 0);
     // The test must exercise both decisions and reversed queries.
-    EXPECT_GT(visible, int(qs.size() / 10));
-    EXPECT_LT(visible, int(qs.size() * 9 / 10));
-    EXPECT_GT(reversed, int(qs.size() / 8));
+    EXPECT_GT(c.visible, int(qs.size() / 10));
+    EXPECT_LT(c.visible, int(qs.size() * 9 / 10));
+    EXPECT_GT(c.reversed, int(qs.size() / 8));
     EXPECT_EQ(ctx.validation_message_count(), 0);
 }
 

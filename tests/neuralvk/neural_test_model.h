@@ -25,4 +25,27 @@ TestModel make_test_model(uint64_t seed, glm::vec3 lo = glm::vec3(-1.0f), glm::v
 // CPU oracle: fp16-emulated forward of the same query (segment points from the shared header).
 neural::Outputs reference_outputs(const TestModel& m, const GpuNeuralQuery& q);
 
+// Random rays through random sub-boxes (leaves) of the asset box `lo`..`hi`; a quarter start inside
+// their leaf (reversed queries).
+std::vector<GpuNeuralQuery> random_queries(uint64_t seed, size_t n, glm::vec3 lo, glm::vec3 hi);
+
+// A GPU kernel's hits against the CPU oracle. Differences are measured, not asserted: the caller
+// checks them against its kernel's bounds (see neural_crosscheck_test.cpp for why they are what they
+// are). Visibility decisions are compared only where the reference lies `vis_margin` or more away
+// from the threshold, acceptance only where the reference hit is that far from the acceptance edge.
+struct CrossCheck {
+    float max_out = 0.0f;        // max |y_gpu - y_ref| over visibility, depth, albedo
+    float max_t = 0.0f;          // max |t_gpu - t_ref| / (segment length + pad)
+    float max_n = 0.0f;          // max |n_gpu - n_ref| where the reference normal is well defined
+    int decisions = 0;           // visibility decisions compared
+    int decision_errors = 0;     // of those, different
+    int acceptance_errors = 0;   // depth acceptance different away from its edge
+    int near_threshold = 0;
+    int visible = 0;
+    int reversed = 0;
+    int non_finite = 0;
+};
+CrossCheck cross_check(const TestModel& m, const std::vector<GpuNeuralQuery>& qs,
+                       const std::vector<GpuNeuralHit>& hits, float vis_margin);
+
 } // namespace nbvh::test
