@@ -124,7 +124,10 @@ bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, inout GpuN
     st.key_t = g_nl_cand_t[n - 1u];
     st.key_instance = g_nl_cand_inst[n - 1u];
     st.key_leaf = g_nl_cand_leaf[n - 1u];
-    st.status = NB_NRAY_PENDING;
+    // Fewer than g_nl_want queued: the candidate list was not full (no leaf in front of the limit was
+    // left out) or a candidate lay behind the limit (so do all later ones). Either way no leaf remains.
+    bool last = n < g_nl_want || st.rounds + n >= neural_params.max_rounds;
+    st.status = last ? NB_NRAY_PENDING_LAST : NB_NRAY_PENDING;
     st.rounds += n;
     return true;
 }
@@ -139,6 +142,8 @@ void nb_nl_take_hit(inout GpuNeuralRayState st, float t, vec3 normal, vec3 albed
         st.instance = instance;
     }
 }
+
+bool nb_nl_is_pending(uint status) { return status == NB_NRAY_PENDING || status == NB_NRAY_PENDING_LAST; }
 
 // The resumed traversal of a ray: the results of its `group` pairs from pending slot `slot` on.
 void nb_nl_reduce_group(uint slot, uint group, inout GpuNeuralRayState st) {

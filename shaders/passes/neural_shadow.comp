@@ -3,7 +3,8 @@
 // state of shadow ray i lives at neural_state[capacity + i]; its best_t < NB_INF means "occluded".
 //   op 0: every shadow ray: triangle any-hit (occluded -> done), else queue the first neural leaf;
 //   op 1: the rays of the pairs just queried (first pair of each ray's group): any accepted hit of the
-//         group -> occluded, done; else queue the next leaves.
+//         group -> occluded, done; the group was the ray's last -> not occluded, done; else queue the
+//         next leaves.
 // shadow.comp then reads the result instead of tracing.
 #version 460
 #include "lib/bindings.glsl"
@@ -25,9 +26,10 @@ void main() {
         if (pl.group == 0u) return; // the first pair of the ray's group resumes it
         i = pl.ray - cap;
         st = neural_state[cap + i];
-        if (st.status != NB_NRAY_PENDING) return;
+        if (!nb_nl_is_pending(st.status)) return;
+        bool last = st.status == NB_NRAY_PENDING_LAST;
         nb_nl_reduce_group(slot, pl.group, st);
-        if (st.best_t < NB_INF) { // a query of the group found an occluder
+        if (last || st.best_t < NB_INF) { // an occluder found, or no leaf left: done without re-traversal
             st.status = NB_NRAY_DONE;
             neural_state[cap + i] = st;
             return;

@@ -37,6 +37,7 @@ void main() {
                           : ray_load1(pc.in_queue, NB_RAY_RNG, i);
     uint root = (shadow || pc.depth != 0u) ? neural_params.root_secondary : neural_params.root_primary;
     GpuNeuralRayState st = neural_state[ray];
+    bool last = st.status == NB_NRAY_PENDING_LAST; // no leaf left behind this group
     // The group queued by the last batched round, in key order.
     uint group = r.pl.group;
     for (uint j = 0u; j < group; ++j) {
@@ -52,10 +53,13 @@ void main() {
             return;
         }
         float limit = shadow ? tmax : min(st.tri_t, st.best_t);
-        nb_nl_begin(st, root, 1u);
-        g_nl_skip_triangles = true;
-        nb_trace(org, dir, tmin, limit, shadow);
-        bool found = g_nl_cand_n > 0u && g_nl_cand_t[0] < limit && st.rounds < neural_params.max_rounds;
+        bool found = false;
+        if (!last) { // (only the first iteration can see last == true: it returns below)
+            nb_nl_begin(st, root, 1u);
+            g_nl_skip_triangles = true;
+            nb_trace(org, dir, tmin, limit, shadow);
+            found = g_nl_cand_n > 0u && g_nl_cand_t[0] < limit && st.rounds < neural_params.max_rounds;
+        }
         if (!found) {
             if (shadow) st.status = NB_NRAY_DONE;
             else nb_nl_finish_path(i, st);

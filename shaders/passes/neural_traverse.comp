@@ -5,7 +5,8 @@
 //   1: the rays of the pairs just queried (pending half nb_nl_half(pc.mode) ^ 1, dispatched indirectly
 //      over them; the first pair of each ray's group): apply the group's hits in key order, re-traverse
 //      the neural instances only (triangles are known), culled by min(triangle hit, best neural hit),
-//      and queue the next leaves into half nb_nl_half(pc.mode);
+//      and queue the next leaves into half nb_nl_half(pc.mode) (a ray whose group was its last,
+//      NB_NRAY_PENDING_LAST, is finished without re-traversal);
 //   2: every ray: rays still undecided keep the best hit found so far (safety net: after the last
 //      batched round passes/neural_tail.comp finishes every ray).
 // A ray is finished when no leaf key remains in front of its best hit; then a closer neural hit
@@ -30,8 +31,14 @@ void main() {
         if (pl.group == 0u) return; // the first pair of the ray's group resumes it
         i = pl.ray;
         st = neural_state[i];
-        if (st.status != NB_NRAY_PENDING) return;
+        if (!nb_nl_is_pending(st.status)) return;
+        bool last = st.status == NB_NRAY_PENDING_LAST;
         nb_nl_reduce_group(slot, pl.group, st);
+        if (last) { // nothing left in front: no re-traversal
+            nb_nl_finish_path(i, st);
+            neural_state[i] = st;
+            return;
+        }
     } else {
         i = gl_GlobalInvocationID.x;
         if (i >= queue_count(q)) return;

@@ -87,6 +87,10 @@ NB_FN bool nb_neural_leaf_interval(vec3 org, vec3 inv_dir, vec3 lo, vec3 hi, NB_
 #define NB_NRAY_TRACE 0u    // needs a traversal round
 #define NB_NRAY_PENDING 1u  // a (ray, leaf) pair is queued
 #define NB_NRAY_DONE 2u
+// A group is queued and is the ray's last: its traversal found fewer leaves than it looked for in
+// front of the best hit (every leaf left in front was queued; hits only move the limit closer), or
+// the leaf budget is spent. The resumed round then finishes the ray without re-traversing.
+#define NB_NRAY_PENDING_LAST 3u
 struct GpuNeuralRayState {
     vec3 normal;    // world-space unit normal of the best neural hit
     float best_t;   // NB_INF: none
