@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstdlib>
-#include <cstring>
 
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>
@@ -80,7 +79,7 @@ void Window::framebuffer_size(uint32_t* width, uint32_t* height) const {
 
 // --- Presenter ----------------------------------------------------------------------------------
 
-Presenter::Presenter(const vk::Context& ctx, const Window& window) : ctx_(ctx), window_(window) {
+Presenter::Presenter(const vk::Context& ctx, const Window& window) : ctx_(ctx), window_(window), display_(ctx) {
     NBVH_VK_CHECK(glfwCreateWindowSurface(ctx_.instance(), window_.handle(), nullptr, &surface_));
     VkBool32 supported = VK_FALSE;
     NBVH_VK_CHECK(vkGetPhysicalDeviceSurfaceSupportKHR(ctx_.physical_device(), ctx_.queue_family(), surface_, &supported));
@@ -269,7 +268,7 @@ void Presenter::ensure_film_image(uint32_t width, uint32_t height) {
     ai.memoryTypeIndex = ctx_.find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
     NBVH_VK_CHECK(vkAllocateMemory(ctx_.device(), &ai, nullptr, &film_memory_));
     NBVH_VK_CHECK(vkBindImageMemory(ctx_.device(), film_image_, film_memory_, 0));
-    staging_ = vk::Buffer(ctx_, uint64_t(width) * height * 4, vk::MemoryKind::host, 0, "viewer film staging");
+    packed_ = vk::Buffer(ctx_, uint64_t(width) * height * 4, vk::MemoryKind::device, 0, "viewer film bytes");
     film_width_ = width;
     film_height_ = height;
 }
@@ -279,11 +278,13 @@ void Presenter::destroy_film_image() {
     if (film_memory_) vkFreeMemory(ctx_.device(), film_memory_, nullptr);
     film_image_ = VK_NULL_HANDLE;
     film_memory_ = VK_NULL_HANDLE;
-    staging_ = vk::Buffer();
+    packed_ = vk::Buffer();
 }
 
-bool Presenter::draw(const uint8_t* rgba, uint32_t width, uint32_t height,
-                     const std::function<void(VkCommandBuffer)>& ui, Screenshot* shot) {
+bool Presenter::draw(const FilmSource& film, const std::function<void(VkCommandBuffer)>& ui, Screenshot* shot) {
+    NBVH_CHECK(film.linear && film.width > 0 && film.height > 0 &&
+               film.linear->size() >= uint64_t(film.width) * film.height * 16u);
+    const uint32_t width = film.width, height = film.height;
     uint32_t fw = 0, fh = 0;
     window_.framebuffer_size(&fw, &fh);
     if (fw == 0 || fh == 0) return false;
@@ -304,20 +305,20 @@ bool Presenter::draw(const uint8_t* rgba, uint32_t width, uint32_t height,
     if (r != VK_SUBOPTIMAL_KHR) NBVH_VK_CHECK(r);
 
     ensure_film_image(width, height);
-    std::memcpy(staging_.mapped(), rgba, size_t(width) * height * 4);
 
     NBVH_VK_CHECK(vkResetCommandBuffer(cmd_, 0));
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     NBVH_VK_CHECK(vkBeginCommandBuffer(cmd_, &bi));
     const VkPipelineStageFlags T = VK_PIPELINE_STAGE_TRANSFER_BIT;
-    // Film bytes -> film image.
+    // Linear film -> display bytes (compute) -> film image.
+    display_.record(cmd_, *film.linear, packed_, width * height, film.exposure, film.tone_map);
     image_barrier(cmd_, film_image_, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, T, 0, T,
                   VK_ACCESS_TRANSFER_WRITE_BIT);
     VkBufferImageCopy copy{};
     copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     copy.imageExtent = {width, height, 1};
-    vkCmdCopyBufferToImage(cmd_, staging_.handle(), film_image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+    vkCmdCopyBufferToImage(cmd_, packed_.handle(), film_image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
     image_barrier(cmd_, film_image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, T,
                   VK_ACCESS_TRANSFER_WRITE_BIT, T, VK_ACCESS_TRANSFER_READ_BIT);
     // Swapchain image: clear (letterbox bars), then the film scaled to fit with its aspect kept.

@@ -1,6 +1,7 @@
 // The viewer's window and swapchain: a GLFW window without a client API, its Vulkan surface, a
 // swapchain, and the per-frame commands that put the film on screen:
-//   film (RGBA8, sRGB-encoded by the host tone map) -> staging buffer -> film image
+//   renderer output (linear RGBA32F, on the GPU) -> display pass (tone map + sRGB -> RGBA8 bytes, as
+//   `nbvh render`'s PNGs; display_pass.h) -> film image
 //   -> clear + aspect-preserving blit into the swapchain image -> render pass (UI drawn on top,
 //   loadOp LOAD) -> [copy to a readback buffer for --screenshot] -> present.
 // One frame in flight: the path tracer waits for its own submissions anyway, so more would buy
@@ -13,6 +14,8 @@
 
 #include <vulkan/vulkan.h>
 
+#include "app/viewer/display_pass.h"
+#include "engine/core/image.h"
 #include "engine/vk/buffer.h"
 #include "engine/vk/context.h"
 
@@ -47,6 +50,14 @@ struct Screenshot {
     std::vector<uint8_t> rgb;
 };
 
+// What a frame shows: the renderer's linear output on the GPU (WavefrontRenderer::output()).
+struct FilmSource {
+    const vk::Buffer* linear = nullptr; // width*height RGBA32F pixels, rows top to bottom
+    uint32_t width = 0, height = 0;
+    float exposure = 0.0f;              // stops
+    ToneMap tone_map = ToneMap::aces;   // as nbvh render's PNGs
+};
+
 class Presenter {
 public:
     Presenter(const vk::Context& ctx, const Window& window);
@@ -60,12 +71,11 @@ public:
     VkFormat format() const { return format_.format; }
     bool can_read_back() const { return can_read_back_; }
 
-    // Draws one frame: `rgba` is width*height sRGB-encoded RGBA8 pixels (rows top to bottom), `ui`
-    // records draw commands inside the render pass. Fills `shot` (when not null and can_read_back())
-    // with the window content. Returns false when nothing was presented (minimised window, or the
-    // swapchain was out of date and has been recreated).
-    bool draw(const uint8_t* rgba, uint32_t width, uint32_t height, const std::function<void(VkCommandBuffer)>& ui,
-              Screenshot* shot = nullptr);
+    // Draws one frame: the film (display pass on the GPU, then scaled to the window), `ui` records draw
+    // commands inside the render pass. Fills `shot` (when not null and can_read_back()) with the window
+    // content. Returns false when nothing was presented (minimised window, or the swapchain was out of
+    // date and has been recreated).
+    bool draw(const FilmSource& film, const std::function<void(VkCommandBuffer)>& ui, Screenshot* shot = nullptr);
 
 private:
     void create_swapchain();
@@ -90,7 +100,8 @@ private:
     VkImage film_image_ = VK_NULL_HANDLE;
     VkDeviceMemory film_memory_ = VK_NULL_HANDLE;
     uint32_t film_width_ = 0, film_height_ = 0;
-    vk::Buffer staging_;  // host-visible RGBA8 film
+    vk::Buffer packed_;   // RGBA8 film bytes, written by the display pass
+    DisplayPass display_;
     vk::Buffer readback_; // host-visible swapchain copy (screenshots)
 
     VkCommandPool pool_ = VK_NULL_HANDLE;

@@ -184,9 +184,6 @@ void run_viewer(const ViewerArgs& a) {
         OrbitCamera cam(home);
         std::unique_ptr<render::WavefrontRenderer> renderer;
         bool rebuild = true, camera_moved = false, restart = false;
-        Image film;
-        std::vector<uint8_t> rgba;
-        float shown_exposure = 0.0f;
         Screenshot shot;
         uint32_t frame = 0;
 
@@ -231,16 +228,14 @@ void run_viewer(const ViewerArgs& a) {
             camera_moved = restart = false;
 
             const bool converged = s.max_samples > 0 && renderer->accumulated_samples() >= uint32_t(s.max_samples);
-            bool new_film = false;
             if (!converged) {
                 const auto f0 = std::chrono::steady_clock::now();
-                render::RenderResult r = renderer->render_progressive(uint32_t(s.spp_per_frame));
+                // The mean stays on the GPU: the presenter's display pass tone-maps it there.
+                render::RenderResult r = renderer->render_progressive(uint32_t(s.spp_per_frame), false);
                 info.frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - f0).count();
                 info.rays_per_second = r.stats.rays_per_second();
                 info.neural_path = r.stats.neural_path;
                 info.neural_queries_per_ray = r.stats.neural_queries_per_ray();
-                film = std::move(r.image);
-                new_film = true;
             }
             info.samples = renderer->accumulated_samples();
             info.width = width;
@@ -256,20 +251,15 @@ void run_viewer(const ViewerArgs& a) {
             rebuild |= act.rebuild;
             restart |= act.reset_accumulation;
             ImGui::Render();
-            if (new_film || shown_exposure != s.exposure || rgba.empty()) {
-                PngEncode enc;
-                enc.exposure = s.exposure;
-                enc.tone_map = ToneMap::aces; // as nbvh render's PNGs
-                enc.keep_alpha = true;
-                int channels = 0;
-                rgba = to_srgb8(film, enc, &channels);
-                NBVH_CHECK(channels == 4);
-                shown_exposure = s.exposure;
-            }
             const bool last = a.frames > 0 && frame + 1 >= a.frames;
             const bool want_shot = last && !a.screenshot.empty();
-            presenter.draw(rgba.data(), uint32_t(film.width), uint32_t(film.height),
-                           s.show_ui ? std::function<void(VkCommandBuffer)>(ImGuiLayer::record)
+            FilmSource film; // the renderer's size: a failed rebuild keeps the previous renderer
+            film.linear = &renderer->output();
+            film.width = renderer->width();
+            film.height = renderer->height();
+            film.exposure = s.exposure;
+            film.tone_map = ToneMap::aces; // as nbvh render's PNGs
+            presenter.draw(film, s.show_ui ? std::function<void(VkCommandBuffer)>(ImGuiLayer::record)
                                      : std::function<void(VkCommandBuffer)>(),
                            want_shot ? &shot : nullptr);
             window.set_title(strfmt("nbvh view: %s | %u spp | %.1f ms/frame", a.scene.c_str(), info.samples,
@@ -282,8 +272,9 @@ void run_viewer(const ViewerArgs& a) {
             if (shot.width > 0) {
                 save_png_8bit(a.screenshot, int(shot.width), int(shot.height), 3, shot.rgb.data());
                 log_info("view: saved the window (%ux%u) to %s", shot.width, shot.height, a.screenshot.c_str());
-            } else if (film.width > 0) {
+            } else if (renderer && frame > 0) {
                 // The surface cannot be read back (or the window closed early): save the film.
+                const Image film = renderer->read_output();
                 PngEncode enc;
                 enc.exposure = s.exposure;
                 enc.tone_map = ToneMap::aces;

@@ -1,5 +1,6 @@
 #include "engine/core/image.h"
 
+#include "shaders/shared/display.h"
 #include "shaders/shared/sampling.h"
 
 #include <algorithm>
@@ -125,30 +126,22 @@ Image::Image(int w, int h, int c, float fill) : width(w), height(h), channels(c)
 // and FLIP's LDR input all go through it.
 float srgb_to_linear(float c) { return nb_srgb_to_linear(c); }
 
-float linear_to_srgb(float c) {
-    return c <= 0.0031308f ? c * 12.92f : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+float linear_to_srgb(float c) { return nb_linear_to_srgb(c); }
+
+uint32_t tone_map_id(ToneMap tm) {
+    switch (tm) {
+    case ToneMap::clamp: return NB_TONE_MAP_CLAMP;
+    case ToneMap::aces: return NB_TONE_MAP_ACES;
+    case ToneMap::reinhard: return NB_TONE_MAP_REINHARD;
+    }
+    return NB_TONE_MAP_CLAMP;
 }
 
 void tone_map_rgb(ToneMap tm, float rgb[3]) {
-    switch (tm) {
-    case ToneMap::clamp:
-        return;
-    case ToneMap::aces:
-        for (int c = 0; c < 3; ++c) {
-            // (k0 x² + k1 x + k2) / (k3 x² + k4 x + k5), k from flip.md §6.4.
-            const float x = rgb[c];
-            const float x2 = x * x;
-            rgb[c] = (x2 * (0.36f * 2.51f) + x * (0.6f * 0.03f)) /
-                     (x2 * (0.36f * 2.43f) + x * (0.6f * 0.59f) + 0.14f);
-        }
-        return;
-    case ToneMap::reinhard: {
-        const float l = 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2];
-        const float s = 1.0f / (1.0f + std::max(l, 0.0f));
-        for (int c = 0; c < 3; ++c) rgb[c] *= s;
-        return;
-    }
-    }
+    const vec3 c = nb_tone_map(tone_map_id(tm), vec3(rgb[0], rgb[1], rgb[2]));
+    rgb[0] = c.x;
+    rgb[1] = c.y;
+    rgb[2] = c.z;
 }
 
 ToneMap parse_tone_map(const std::string& name) {
@@ -179,23 +172,14 @@ std::vector<uint8_t> to_srgb8(const Image& img, const PngEncode& enc, int* out_c
     const int out_c = (enc.keep_alpha && img.channels == 4) ? 4 : 3;
     if (out_channels) *out_channels = out_c;
     const float scale = std::exp2(enc.exposure);
+    const uint32_t tm = tone_map_id(enc.tone_map);
     std::vector<uint8_t> out(img.pixel_count() * size_t(out_c));
-    auto to8 = [](float v) {
-        if (!std::isfinite(v)) v = 0.0f; // NaN/-Inf (and +Inf after clamp handling below) never reach a PNG
-        v = std::clamp(v, 0.0f, 1.0f);
-        return uint8_t(std::lround(v * 255.0f));
-    };
     for (size_t i = 0; i < img.pixel_count(); ++i) {
         const float* p = img.data.data() + i * size_t(img.channels);
-        float rgb[3];
-        for (int c = 0; c < 3; ++c) {
-            float v = p[img.channels >= 3 ? c : 0];
-            if (std::isnan(v)) v = 0.0f;
-            rgb[c] = std::min(v * scale, 3.0e38f); // +Inf -> large finite, maps to white
-        }
-        tone_map_rgb(enc.tone_map, rgb);
-        for (int c = 0; c < 3; ++c) out[i * out_c + c] = to8(linear_to_srgb(std::clamp(rgb[c], 0.0f, 1.0f)));
-        if (out_c == 4) out[i * out_c + 3] = to8(p[3]);
+        const vec3 linear(p[0], p[img.channels >= 3 ? 1 : 0], p[img.channels >= 3 ? 2 : 0]);
+        const uvec3 b = nb_display_rgb8(linear, scale, tm); // shaders/shared/display.h (the viewer's GPU pass too)
+        for (int c = 0; c < 3; ++c) out[i * out_c + c] = uint8_t(b[c]);
+        if (out_c == 4) out[i * out_c + 3] = uint8_t(nb_display_byte(p[3]));
     }
     return out;
 }

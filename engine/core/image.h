@@ -46,6 +46,8 @@ float linear_to_srgb(float c);
 
 // Per-channel (aces) or per-pixel (reinhard) tone map of an RGB triple, in place; clamp does nothing.
 void tone_map_rgb(ToneMap tm, float rgb[3]);
+// The tone map's id in shaders/shared/display.h (NB_TONE_MAP_*), for GPU passes.
+uint32_t tone_map_id(ToneMap tm);
 ToneMap parse_tone_map(const std::string& name); // "clamp", "aces", "reinhard"; throws Error otherwise
 
 // Loading: picks the decoder by extension (.png .jpg .jpeg .bmp .tga -> 8-bit sRGB; .hdr -> linear;

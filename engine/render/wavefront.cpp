@@ -253,13 +253,21 @@ void WavefrontRenderer::set_camera(const Camera& camera) {
     accumulated_ = 0;
 }
 
-RenderResult WavefrontRenderer::render_progressive(uint32_t samples) {
-    RenderResult result = render_samples(accumulated_, samples);
+RenderResult WavefrontRenderer::render_progressive(uint32_t samples, bool read_back) {
+    RenderResult result = render_samples(accumulated_, samples, read_back);
     accumulated_ += samples;
     return result;
 }
 
-RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_samples) {
+const vk::Buffer& WavefrontRenderer::output() const { return buffers_[NB_BIND_OUTPUT]; }
+
+Image WavefrontRenderer::read_output() const {
+    Image image(int(options_.width), int(options_.height), 4);
+    buffers_[NB_BIND_OUTPUT].download(image.data.data(), uint64_t(options_.width) * options_.height * sizeof(vec4));
+    return image;
+}
+
+RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_samples, bool read_back) {
     const auto t0 = std::chrono::steady_clock::now();
     const uint32_t pixels = options_.width * options_.height;
     if (first == 0) buffers_[NB_BIND_FILM].fill(0u);
@@ -299,8 +307,7 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
     collect();
 
     RenderResult result;
-    result.image = Image(int(options_.width), int(options_.height), 4);
-    buffers_[NB_BIND_OUTPUT].download(result.image.data.data(), uint64_t(pixels) * sizeof(vec4));
+    if (read_back) result.image = read_output();
     const GpuQueueCounters counters = buffers_[NB_BIND_COUNTERS].download<GpuQueueCounters>(1)[0];
 
     RenderStats& s = result.stats;

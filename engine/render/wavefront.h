@@ -90,9 +90,16 @@ public:
     // Progressive rendering (the interactive viewer, app/viewer/): `set_camera` changes the view of
     // later samples and clears the film; `render_progressive` adds `samples` samples per pixel to the
     // film and reads back the running mean (stats: rays and times of this call; spp = samples so far).
+    // With read_back false the mean stays on the GPU (result.image is empty): output() holds it, for a
+    // display pass (the viewer), and read_output() fetches it later.
     void set_camera(const Camera& camera);
-    RenderResult render_progressive(uint32_t samples = 1);
+    RenderResult render_progressive(uint32_t samples = 1, bool read_back = true);
     uint32_t accumulated_samples() const { return accumulated_; }
+    // Linear RGBA32F mean radiance of the last render, width*height pixels, rows top to bottom.
+    const vk::Buffer& output() const;
+    uint32_t width() const { return options_.width; }
+    uint32_t height() const { return options_.height; }
+    Image read_output() const;
 
     // Closest hits of world-space rays (org, dir; t in [tmin, inf)) through passes/traverse.comp.
     std::vector<TraceHit> trace(const std::vector<glm::vec3>& origins, const std::vector<glm::vec3>& dirs, float tmin = 0.0f);
@@ -107,7 +114,7 @@ private:
     void record_neural_rounds(vk::CommandBuffer& cmd, size_t traverse_pass, uint32_t q, uint32_t depth, uint32_t sample,
                               uint32_t offset, uint32_t count);
     // Samples [first, first + count) into the film (cleared when first == 0), then resolve + read back.
-    RenderResult render_samples(uint32_t first, uint32_t count);
+    RenderResult render_samples(uint32_t first, uint32_t count, bool read_back = true);
 
     const vk::Context& ctx_;
     RenderOptions options_;
