@@ -14,7 +14,7 @@
 // shapes and subgroup size 32 (engine/render/neural_model_gpu.cpp checks). The including shader
 // declares `float16_t neural_mlp_h[];` (the TRANSPOSED weight buffer seen as halves), defines NB_COOP_ACC_BITS,
 // fills nb_sh_x (query row r, features in mlp.h input order: nb_coop_x_write4) and calls
-// nb_mlp_forward_coopmat() from uniform control flow; outputs (after the sigmoid) are then in
+// nb_mlp_forward_coopmat() from uniform control flow; the 8 outputs (fp32, before the sigmoid) are then in
 // nb_sh_y[r*NB_COOP_Y_STRIDE + 0..7].
 #ifndef NB_NEURAL_MLP_COOPMAT_GLSL
 #define NB_NEURAL_MLP_COOPMAT_GLSL
