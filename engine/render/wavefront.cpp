@@ -359,13 +359,21 @@ std::vector<TraceHit> WavefrontRenderer::trace(const std::vector<glm::vec3>& ori
         GpuQueueCounters counters{};
         counters.ray_count0 = n;
         buffers_[NB_BIND_COUNTERS].upload(&counters, sizeof(counters));
+        if (neural_) buffers_[NB_BIND_NEURAL_COUNTERS].fill(0u);
         cmd_.begin();
         if (timer_.available()) timer_.reset(cmd_.handle());
         record_pass(cmd_, QUEUE_ARGS, constants(0, 0, 0, 0, n, NB_ARGS_MODE_RAYS), Dispatch::single);
-        record_pass(cmd_, TRAVERSE, constants(0, 0, 0, 0, n, 0), Dispatch::indirect_rays);
+        if (neural_) { // as record_sample_wave at depth 0
+            record_neural_rounds(cmd_, NEURAL_TRAVERSE, 0, 0, 0, 0, n);
+            record_pass(cmd_, NEURAL_TRAVERSE, constants(0, 0, 0, 0, n, 2), Dispatch::indirect_rays);
+        } else {
+            record_pass(cmd_, TRAVERSE, constants(0, 0, 0, 0, n, 0), Dispatch::indirect_rays);
+        }
         cmd_.barrier(vk::Barrier::compute_to_transfer);
         cmd_.submit_and_wait();
         const std::vector<uint32_t> hits = buffers_[NB_BIND_HITS].download<uint32_t>(size_t(capacity_) * NB_HIT_WORDS);
+        std::vector<GpuNeuralRayState> states;
+        if (neural_) states = buffers_[NB_BIND_NEURAL_STATE].download<GpuNeuralRayState>(n);
         for (uint32_t i = 0; i < n; ++i) {
             TraceHit h;
             const uint32_t inst = hits[nb_hit_word(NB_HIT_INSTANCE, capacity_, i, 1)];
@@ -373,6 +381,12 @@ std::vector<TraceHit> WavefrontRenderer::trace(const std::vector<glm::vec3>& ori
                 h.t = uintBitsToFloat(hits[nb_hit_word(NB_HIT_T, capacity_, i, 1)]);
                 h.instance = data_.instance_to_scene[inst];
                 const uint32_t tri = hits[nb_hit_word(NB_HIT_TRIANGLE, capacity_, i, 1)];
+                if (neural_ && tri == NB_NEURAL_TRIANGLE) {
+                    h.neural = true;
+                    h.normal = states[i].normal;
+                    out.push_back(h);
+                    continue;
+                }
                 h.triangle = tri < data_.triangle_to_mesh_triangle.size() ? data_.triangle_to_mesh_triangle[tri] : tri;
                 h.u = uintBitsToFloat(hits[nb_hit_word(NB_HIT_BARY, capacity_, i, 2)]);
                 h.v = uintBitsToFloat(hits[nb_hit_word(NB_HIT_BARY, capacity_, i, 2) + 1]);

@@ -71,8 +71,10 @@ struct RenderResult {
 struct TraceHit {
     float t = NB_INF;
     uint32_t instance = 0xFFFFFFFFu; // Scene::instances index; 0xFFFFFFFF: miss
-    uint32_t triangle = 0xFFFFFFFFu; // original triangle index in the instance's mesh
+    uint32_t triangle = 0xFFFFFFFFu; // original triangle index in the instance's mesh (neural: 0xFFFFFFFF)
     float u = 0.0f, v = 0.0f;
+    bool neural = false;             // answered by the network (hybrid renderers)
+    glm::vec3 normal{0.0f};          // neural hits: the predicted world-space unit normal
 };
 
 class WavefrontRenderer {
@@ -101,7 +103,9 @@ public:
     uint32_t height() const { return options_.height; }
     Image read_output() const;
 
-    // Closest hits of world-space rays (org, dir; t in [tmin, inf)) through passes/traverse.comp.
+    // Closest hits of world-space rays (org, dir; t in [tmin, inf)) through passes/traverse.comp, or, in
+    // a hybrid renderer, through the same neural rounds as camera rays (primary LoD, leaf budget and
+    // leaves per round of the options): triangles and neural leaves, closest accepted hit.
     std::vector<TraceHit> trace(const std::vector<glm::vec3>& origins, const std::vector<glm::vec3>& dirs, float tmin = 0.0f);
 
 private:
