@@ -7,6 +7,7 @@
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/scene/camera.h"
+#include "shaders/shared/intersect.h"
 #include "shaders/shared/wavefront_gpu.h"
 
 namespace nbvh::render {
@@ -100,7 +101,7 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     p.seed = options_.seed;
     p.spp = options_.spp;
     p.wave_capacity = capacity_;
-    p.ray_epsilon = 1.0e-5f * data_.scene_extent;
+    p.ray_epsilon = NB_RAY_EPSILON_SCALE * data_.scene_extent;
     p.instance_count = accel.tlas.prim_indices.empty() ? 0u : uint32_t(data_.instances.size());
 
     // Buffers, indexed by binding.

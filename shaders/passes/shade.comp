@@ -11,6 +11,7 @@
 #include "lib/env.glsl"
 #include "lib/lights.glsl"
 #include "lib/neural_surface.glsl"
+#include "shared/intersect.h"
 
 layout(local_size_x = NB_WAVEFRONT_GROUP) in;
 
@@ -21,10 +22,7 @@ float env_choice_probability() {
     return 0.5f;
 }
 
-vec3 ray_offset(vec3 p, vec3 n) {
-    vec3 ap = abs(p);
-    return p + n * (params.ray_epsilon + 4.0e-6f * max(ap.x, max(ap.y, ap.z)));
-}
+vec3 ray_offset(vec3 p, vec3 n) { return nb_ray_offset(p, n, params.ray_epsilon); }
 
 void main() {
     uint i = gl_GlobalInvocationID.x;

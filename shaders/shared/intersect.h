@@ -20,6 +20,17 @@
 // triangle the ray hits (grazing rays, face-on flat boxes, coplanar triangles).
 #define NB_SLAB_SLACK 2.0e-6f
 
+// Origin of a ray leaving surface point p along unit normal n (turned to the side the ray leaves): offset
+// by `epsilon` (GpuFrameParams::ray_epsilon = NB_RAY_EPSILON_SCALE x the scene extent) plus
+// NB_RAY_OFFSET_RELATIVE of p's largest coordinate, so the offset stays above the float spacing far from
+// the origin. passes/shade.comp and the secondary-ray tests use it.
+#define NB_RAY_EPSILON_SCALE 1.0e-5f
+#define NB_RAY_OFFSET_RELATIVE 4.0e-6f
+NB_FN vec3 nb_ray_offset(vec3 p, vec3 n, float epsilon) {
+    float m = max(abs(p.x), max(abs(p.y), abs(p.z)));
+    return p + n * (epsilon + NB_RAY_OFFSET_RELATIVE * m);
+}
+
 // Reciprocal direction that never divides by zero: components with |d| < NB_PARALLEL_EPS become
 // +-NB_INF (a finite float), which nb_intersect_aabb* read as "parallel". Use this on the GPU, where
 // division by zero is undefined in Vulkan.

@@ -9,7 +9,7 @@
 // kernel (NeuralEvaluator: shared encode + network + decode, incl. the reversed-query margin
 // depth_eps * L + fixed_eps); a hit counts when visible, accepted, t > tmin and closer than the best.
 // Everything is in the asset's object space (the network's space); the secondary-ray offset is
-// shade.comp's ray_offset with the scene extent taken as the asset diagonal.
+// shade.comp's (shared nb_ray_offset) with the scene extent taken as the asset diagonal.
 #include "engine/bvh/mesh_bvh.h"
 #include "engine/bvh/scene_accel.h"
 #include "engine/neural/nbvh_tree.h"
@@ -145,6 +145,19 @@ void outside_rays(const Aabb& box, size_t count, uint32_t seed, std::vector<glm:
 
 bool finite3(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
+// `count` secondary rays leaving hit point p of a ray along `dir`: the origin offset as shade.comp does
+// (shared nb_ray_offset, with `extent` as the scene extent) along the normal turned towards the ray,
+// cosine-distributed directions about it.
+void add_secondary_rays(glm::vec3 p, glm::vec3 normal, glm::vec3 dir, float extent, int count, std::mt19937& rng,
+                        std::vector<glm::vec3>& so, std::vector<glm::vec3>& sd) {
+    const glm::vec3 n = glm::dot(normal, dir) < 0.0f ? normal : -normal;
+    const glm::vec3 o = nb_ray_offset(p, n, NB_RAY_EPSILON_SCALE * extent);
+    for (int k = 0; k < count; ++k) {
+        so.push_back(o);
+        sd.push_back(cosine_hemisphere(rng, n));
+    }
+}
+
 } // namespace
 
 // (1) Self-hits. Camera-like rays from outside hit the neural bunny; from every neural hit (point,
@@ -182,13 +195,7 @@ TEST(SecondaryRays, NoSelfHitsLeavingNeuralSurface) {
             continue;
         }
         ++hits;
-        const glm::vec3 n = glm::dot(primary[i].normal, dir[i]) < 0.0f ? primary[i].normal : -primary[i].normal;
-        const glm::vec3 ap = glm::abs(p);
-        const glm::vec3 o = p + n * (1.0e-5f * diag + 4.0e-6f * std::max(ap.x, std::max(ap.y, ap.z)));
-        for (int k = 0; k < PER_HIT; ++k) {
-            so.push_back(o);
-            sd.push_back(cosine_hemisphere(rng, n));
-        }
+        add_secondary_rays(p, primary[i].normal, dir[i], diag, PER_HIT, rng, so, sd);
     }
     EXPECT_EQ(nonfinite, 0u);
     ASSERT_GT(hits, 64u) << "too few primary neural hits to measure anything";
@@ -361,22 +368,13 @@ TEST(SecondaryRays, RendererNeuralRoundsAgreeWithTheHostReplay) {
     EXPECT_LT(max_dn, 1e-3f);
 
     // Secondary rays from the renderer's hits.
+    const float wdiag = glm::length(glm::mat3(m) * box.extent());
     std::mt19937 rng(8);
     std::vector<glm::vec3> so, sd;
-    for (size_t i = 0; i < got.size(); ++i) {
-        if (!(got[i].t < NB_INF) || !got[i].neural) continue;
-        const glm::vec3 p = worg[i] + wdir[i] * got[i].t;
-        const glm::vec3 n = glm::dot(got[i].normal, wdir[i]) < 0.0f ? got[i].normal : -got[i].normal;
-        const glm::vec3 ap = glm::abs(p);
-        const float wdiag = glm::length(glm::mat3(m) * box.extent());
-        const glm::vec3 so_i = p + n * (1.0e-5f * wdiag + 4.0e-6f * std::max(ap.x, std::max(ap.y, ap.z)));
-        for (int k = 0; k < 4; ++k) {
-            so.push_back(so_i);
-            sd.push_back(cosine_hemisphere(rng, n));
-        }
-    }
+    for (size_t i = 0; i < got.size(); ++i)
+        if (got[i].t < NB_INF && got[i].neural)
+            add_secondary_rays(worg[i] + wdir[i] * got[i].t, got[i].normal, wdir[i], wdiag, 4, rng, so, sd);
     const std::vector<TraceHit> sec = renderer.trace(so, sd);
-    const float wdiag = glm::length(glm::mat3(m) * box.extent());
     size_t self = 0, any = 0;
     for (const TraceHit& h : sec) {
         if (!(h.t < NB_INF)) continue;
