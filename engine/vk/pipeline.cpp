@@ -4,7 +4,6 @@
 #include "shaders/shader_registry.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <utility>
@@ -104,7 +103,7 @@ bool ComputePipeline::statistics_requested(const Context& ctx) {
 }
 
 // The driver's statistics of the compiled pipeline (registers, shared memory, instruction counts: whatever
-// the driver reports), one line per executable on stderr. A benchmarking aid: NBVH_PIPELINE_STATS=1.
+// the driver reports), one log line per executable. A benchmarking aid: NBVH_PIPELINE_STATS=1.
 void ComputePipeline::log_statistics(const Context& ctx) const {
     VkDevice dev = ctx.device();
     auto get_execs = (PFN_vkGetPipelineExecutablePropertiesKHR)vkGetDeviceProcAddr(
@@ -135,7 +134,7 @@ void ComputePipeline::log_statistics(const Context& ctx) const {
             default: line += "?"; break;
             }
         }
-        std::fprintf(stderr, "%s\n", line.c_str());
+        log_info("%s", line.c_str());
     }
 }
 

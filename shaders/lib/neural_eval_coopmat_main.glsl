@@ -29,7 +29,7 @@ void main() {
         for (uint f = 0u; f < NB_MLP_INPUTS; f += 4u) {
             vec4 v;
             for (uint c = 0u; c < 4u; ++c) v[c] = float(((i * 7u + f + c) & 15u)) * (1.0f / 16.0f) + p0.x;
-            nb_coop_x_write4(local, f, vec4(unpackHalf2x16(packHalf2x16(v.xy)), unpackHalf2x16(packHalf2x16(v.zw))));
+            nb_coop_x_write4(local, f, v); // packing rounds to fp16
         }
     } else {
         nb_coop_stage_features(local, valid, p0, p1, p2);
