@@ -41,7 +41,16 @@ bool has_shape(const vk::DeviceFeatures& dev, VkComponentTypeNV acc) {
 }
 } // namespace
 
-bool has_fp16_accumulate_shape(const vk::DeviceFeatures& dev) { return has_shape(dev, VK_COMPONENT_TYPE_FLOAT16_NV); }
+std::vector<NeuralKernelChoice> coopmat_kernels(const vk::DeviceFeatures& dev) {
+    std::vector<NeuralKernelChoice> out;
+    if (!coopmat_unavailable_reason(dev).empty()) return out;
+    out.push_back(choose_neural_kernel(dev, NeuralPath::coopmat));
+    if (out[0].fp32_accumulate && has_shape(dev, VK_COMPONENT_TYPE_FLOAT16_NV)) {
+        out.push_back(out[0]);
+        out.back().fp32_accumulate = false;
+    }
+    return out;
+}
 
 std::string coopmat_unavailable_reason(const vk::DeviceFeatures& dev) {
     if (!dev.coop_matrix_nv) return "the device lacks VK_NV_cooperative_matrix";

@@ -36,12 +36,14 @@ struct NeuralKernelChoice {
 NeuralKernelChoice choose_neural_kernel(const vk::DeviceFeatures& dev, NeuralPath requested);
 // Why the cooperative-matrix path is unavailable ("" when it is available).
 std::string coopmat_unavailable_reason(const vk::DeviceFeatures& dev);
-// The device has the 16x16x16 fp16 -> fp16 shape (the fp16-accumulator kernel can run).
-bool has_fp16_accumulate_shape(const vk::DeviceFeatures& dev);
+// Every cooperative-matrix kernel the device can run, the one `auto` picks first (fp32 accumulators
+// where available, then the fp16-accumulator one); empty without cooperative matrices. For tests and
+// benchmarks that check each kernel on real hardware.
+std::vector<NeuralKernelChoice> coopmat_kernels(const vk::DeviceFeatures& dev);
 
-// Shader of the fp32-accumulating cooperative-matrix kernel: kind "eval" or "query". It is variant "g"
-// of the kernels measured in results/neural/README.md (v8-v10: MLP loops unrolled, subgroup barriers,
-// gather loops rolled), the fastest on the H200; the slower variants were removed (git history).
+// Shader of the fp32-accumulating cooperative-matrix kernel: kind "eval" or "query" (MLP loops unrolled,
+// subgroup barriers, weight tiles, paired gather of 4 levels at once: results/neural/README.md v8-v17;
+// the slower variants measured there are in the git history only).
 const char* coopmat_fp32_shader(const char* kind);
 
 // Host-side packing (pure CPU, unit-testable).

@@ -114,18 +114,12 @@ int main(int argc, char** argv) try {
 
     struct Row { std::string path; double ms = 0; double qps = 0; std::vector<GpuNeuralHit> hits; };
     std::vector<Row> rows;
-    std::vector<NeuralPath> paths = {NeuralPath::scalar};
     const std::string why = coopmat_unavailable_reason(dev);
-    if (why.empty()) paths.push_back(NeuralPath::coopmat);
-    else std::printf("cooperative-matrix path unavailable: %s\n", why.c_str());
-    std::vector<NeuralKernelChoice> choices;
-    for (NeuralPath p : paths) choices.push_back(choose_neural_kernel(dev, p));
-    // Where the device has both, the fp16-accumulator kernel too (the fallback of devices without fp32
-    // accumulation), so that it is checked on real hardware.
-    if (why.empty() && choices.back().fp32_accumulate && has_fp16_accumulate_shape(dev)) {
-        choices.push_back(choices.back());
-        choices.back().fp32_accumulate = false;
-    }
+    if (!why.empty()) std::printf("cooperative-matrix path unavailable: %s\n", why.c_str());
+    // Scalar, then every cooperative-matrix kernel (where the device has both, the fp16-accumulator
+    // fallback too, so that it is checked on real hardware).
+    std::vector<NeuralKernelChoice> choices = {choose_neural_kernel(dev, NeuralPath::scalar)};
+    for (const NeuralKernelChoice& c : coopmat_kernels(dev)) choices.push_back(c);
     for (const NeuralKernelChoice& choice : choices) {
         NeuralEvaluator ev(ctx, gpu, choice);
         Row r;

@@ -44,11 +44,8 @@ TEST(NeuralCoopmat, KernelsMatchFp16Reference) {
     // Not a multiple of the 64-query workgroup: the last workgroup is partial.
     const std::vector<GpuNeuralQuery> qs = test::random_queries(11, 20000 + 37, lo, hi);
 
-    std::vector<NeuralKernelChoice> choices = {choose_neural_kernel(ctx->features(), NeuralPath::coopmat)};
-    if (choices[0].fp32_accumulate && has_fp16_accumulate_shape(ctx->features())) {
-        choices.push_back(choices[0]);
-        choices.back().fp32_accumulate = false;
-    }
+    const std::vector<NeuralKernelChoice> choices = coopmat_kernels(ctx->features());
+    ASSERT_FALSE(choices.empty());
     for (const NeuralKernelChoice& choice : choices) {
         const float bound = choice.fp32_accumulate ? 2e-3f : 1e-2f;
         NeuralEvaluator eval(*ctx, gpu, choice);
