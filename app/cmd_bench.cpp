@@ -75,22 +75,6 @@ Image as_png_pixels(const Image& linear) {
     return out;
 }
 
-// The model must be of this scene's neural asset: the glTF mesh name (and triangle count when known).
-void check_model_matches(const Scene& scene, const NeuralModel& m, const std::string& model_path) {
-    std::string names;
-    for (const Instance& inst : scene.instances) {
-        if (!inst.neural) continue;
-        const Mesh& mesh = scene.meshes[inst.mesh];
-        const bool tris_ok = m.meta.source_triangles == 0 || m.meta.source_triangles == mesh.triangle_count();
-        if ((m.asset_name.empty() || m.asset_name == mesh.name) && tris_ok) return;
-        names += (names.empty() ? "'" : ", '") + mesh.name + strfmt("' (%u triangles)", mesh.triangle_count());
-    }
-    if (names.empty()) throw Error("the scene has no neural instance (mark one with --neural)");
-    throw Error(strfmt("model '%s' was trained for asset '%s' (%llu triangles), not this scene's neural %s",
-                       model_path.c_str(), m.asset_name.c_str(), (unsigned long long)m.meta.source_triangles,
-                       names.c_str()));
-}
-
 // GPU bytes of the model rendered at LoD `lod`: the cut's interior nodes instead of LoD 0's.
 uint64_t lod_gpu_bytes(const NeuralModel& m, uint32_t lod) {
     const uint64_t all = model_gpu_bytes(m);
@@ -107,8 +91,7 @@ void run_bench(const BenchArgs& a) {
     options.neural.path = render::parse_neural_path(a.neural_path);
     if (a.repeat == 0) throw Error("--repeat must be at least 1");
     const NeuralModel model = load_model(a.model);
-    const Scene scene = load_scene_arg(a.scene);
-    check_model_matches(scene, model, a.model);
+    const Scene scene = load_scene_for_model(a.scene, {}, &model, a.model);
     const Environment env = choose_environment(scene, a.env);
     const Camera camera = choose_camera(scene, a.camera, options);
     vk::Context ctx(copt);
@@ -161,7 +144,7 @@ void run_bench(const BenchArgs& a) {
     if (a.json.empty()) return;
     nlohmann::json ref_passes = nlohmann::json::object();
     for (const auto& [name, ms] : ref.stats.pass_ms) ref_passes[name] = ms;
-    nlohmann::json j = {{"scene", a.scene}, {"model", a.model}, {"asset", model.asset_name},
+    nlohmann::json j = {{"scene", a.scene}, {"model", a.model}, {"assets", model.assets.size()},
                         {"device", ref.stats.device}, {"driver", ref.stats.driver}, {"width", options.width},
                         {"height", options.height}, {"spp", options.spp}, {"max_depth", options.max_depth},
                         {"repeat", a.repeat}, {"neural_path", path_name},

@@ -42,7 +42,11 @@ void print_model(const std::string& path) {
     const NbvhTree tree = m.tree();
     const NeuralConfig& c = m.cfg;
     std::printf("model        %s (format version %u)\n", path.c_str(), MODEL_FORMAT_VERSION);
-    std::printf("asset        %s\n", m.asset_name.empty() ? "(unnamed)" : m.asset_name.c_str());
+    std::printf("assets       %zu (each its own N-BVH subtree, one shared network)\n", m.assets.size());
+    for (const ModelAsset& as : m.assets)
+        std::printf("  %-28s %8u triangles  %zu node%s  root %u  scale %g%s\n", as.name.c_str(), as.triangles,
+                    as.node_paths.size(), as.node_paths.size() == 1 ? "" : "s", as.root, double(as.scale),
+                    as.geometry_hash ? "" : "  (no fingerprint: format version 1)");
     std::printf("encoding box (%g, %g, %g) - (%g, %g, %g)\n", m.encoding_box.lo.x, m.encoding_box.lo.y,
                 m.encoding_box.lo.z, m.encoding_box.hi.x, m.encoding_box.hi.y, m.encoding_box.hi.z);
     std::printf("hash grid    %u levels x %u features, base resolution %u, per-level scale %g, 2^%u entries per "

@@ -82,14 +82,13 @@ void run_render(const RenderArgs& a) {
     copt.device = vk::parse_device_choice(a.device);
     SceneLoadOptions lo;
     lo.neural_glob = a.neural_glob;
-    Scene scene = load_scene_arg(a.scene, lo);
-    if (a.scene == "default" && !a.neural_glob.empty()) mark_neural_by_glob(scene, a.neural_glob);
     render::RenderOptions options = a.options;
     NeuralModel model;
-    if (!a.model.empty() && !options.neural.classical) {
-        model = load_model(a.model);
-        options.neural.model = &model;
-    }
+    if (!a.model.empty()) model = load_model(a.model);
+    // With a model (also for --classical: the same instances, from their triangles) its asset table
+    // decides which instances are neural.
+    Scene scene = load_scene_for_model(a.scene, lo, a.model.empty() ? nullptr : &model, a.model);
+    if (!a.model.empty() && !options.neural.classical) options.neural.model = &model;
     options.neural.path = render::parse_neural_path(a.neural_path);
     const Environment env = choose_environment(scene, a.env);
     const Camera camera = choose_camera(scene, a.camera, a.options);
@@ -138,7 +137,7 @@ void add_render_command(CLI::App& app) {
     cmd->add_flag("--explain", args->explain, "print the scene's feature set and the passes, then exit");
     cmd->add_option("--model", args->model, "N-BVH model (.nbvh) for the scene's neural instances (hybrid render)");
     cmd->add_flag("--classical", args->options.neural.classical,
-                  "reference: neural instances from their triangles, shaded with the neural material constants");
+                  "reference: the true scene (neural instances from their triangles and glTF materials)");
     cmd->add_option("--neural", args->neural_glob, "nodes whose name matches this glob are neural instances");
     cmd->add_option("--lod", args->options.neural.lod, "N-BVH level of detail of camera rays (0 = finest)");
     cmd->add_option("--secondary-lod", args->options.neural.secondary_lod,

@@ -4,25 +4,30 @@
 #include <cmath>
 #include <numbers>
 
+#include "engine/core/error.h"
 #include "shaders/shared/neural_query.h"
 #include "trainer/ground_truth.h"
 
 namespace nbvh {
 
 EvalStats evaluate_network(const TrainingAsset& asset, const TrainingCut& cut, const neural::NetworkWeights& weights,
-                           uint32_t rays, uint64_t seed) {
+                           uint32_t rays, uint64_t seed, int32_t part) {
     EvalStats e;
     uint32_t agree = 0;
     std::vector<double> depth_err;
     double depth_abs_sum = 0.0, normal_sum = 0.0, albedo_sum = 0.0;
-    const float diag = glm::length(asset.bounds.extent());
-    const glm::vec3 lo = asset.sampling_box.lo, ext = asset.sampling_box.extent();
+    NBVH_CHECK(part < int32_t(asset.parts.size()));
     // Seeds far from the training streams (which use `seed` ^ step hashes with slot streams).
     Pcg32 rng(seed ^ 0xD1B54A32D192ED03ull, 0x5EED);
     for (uint64_t attempt = 0; e.rays < rays && attempt < uint64_t(rays) * 1000u; ++attempt) {
+        const TrainingPart& p = asset.parts[part >= 0                ? uint32_t(part)
+                                            : asset.parts.size() > 1 ? pick_part(asset, rng.next_float())
+                                                                     : 0u];
+        const float diag = glm::length(p.bounds.extent());
+        const glm::vec3 lo = p.sampling_box.lo, ext = p.sampling_box.extent();
         const glm::vec3 o = lo + ext * glm::vec3(rng.next_float(), rng.next_float(), rng.next_float());
         const glm::vec3 d = uniform_sphere_direction(rng.next_float(), rng.next_float());
-        const FirstLeaf f = first_leaf_of_cut(asset.bvh(), asset.node_boxes, cut, o, d, 1e-5f, asset.min_exit);
+        const FirstLeaf f = first_leaf_of_cut(asset.bvh(), asset.node_boxes, cut, o, d, 1e-5f, asset.min_exit, p.root);
         if (f.leaf < 0) continue;
         // Whole forward segment of the leaf (as trained; the renderer's inside-origin reversal is a
         // decode rule on top of the same network).

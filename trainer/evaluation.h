@@ -24,7 +24,8 @@ struct EvalStats {
 };
 
 // `leaves`: base-BVH node ids of the cut (e.g. the final cut's leaves mapped to base nodes).
+// `part`: evaluate one part of a multi-asset run (rays of its sampling box); -1: every part, as trained.
 EvalStats evaluate_network(const TrainingAsset& asset, const TrainingCut& cut, const neural::NetworkWeights& weights,
-                           uint32_t rays, uint64_t seed);
+                           uint32_t rays, uint64_t seed, int32_t part = -1);
 
 } // namespace nbvh

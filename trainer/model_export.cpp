@@ -3,6 +3,7 @@
 #include <ctime>
 
 #include "engine/core/error.h"
+#include "engine/neural/asset_table.h"
 
 namespace nbvh {
 
@@ -12,9 +13,20 @@ NeuralModel make_neural_model(const TrainingAsset& asset, const TrainResult& res
     NeuralModel m;
     m.cfg = result.weights.cfg;
     m.levels = result.weights.levels;
-    m.asset_name = asset.name;
     m.encoding_box = asset.bounds; // the renderer rebuilds GpuEncodingBox with nb_make_encoding_box
     set_tree(m, result.tree);
+    // The asset table: each part's description and the N-BVH node of its subtree root.
+    std::vector<uint32_t> node_of_base(asset.bvh().nodes.size(), NBVH_NO_CHILD);
+    for (uint32_t i = 0; i < m.nodes.size(); ++i)
+        if (m.nodes[i].base_node < node_of_base.size()) node_of_base[m.nodes[i].base_node] = i;
+    for (const TrainingPart& p : asset.parts) {
+        ModelAsset a = describe_asset(*asset.scene, p.mesh_index);
+        a.root = node_of_base[p.root];
+        NBVH_CHECK(a.root != NBVH_NO_CHILD);
+        a.scale = p.scale;
+        a.offset = p.offset;
+        m.assets.push_back(std::move(a));
+    }
     m.mlp = neural::mlp_to_fp16(result.weights);
     m.grid = neural::grid_to_fp16(result.weights);
     TrainingMetadata& meta = m.meta;

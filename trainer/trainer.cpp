@@ -137,7 +137,16 @@ TrainResult train_asset(const TrainingAsset& asset, const TrainOptions& options,
     const neural::AdamConfig adam = make_adam_config(options);
     SplitScheduler scheduler(schedule);
     NbvhTree tree(asset.bvh(), options.lods);
-    std::vector<NodeStats> stats(1);
+    // Several parts (assets): the cut starts at the part roots; the nodes above them only join the parts
+    // and are never a leaf, at any LoD.
+    for (;;) {
+        std::vector<uint32_t> above;
+        for (uint32_t n : tree.leaves())
+            if (tree.node(n).base_node < asset.above_parts.size() && asset.above_parts[tree.node(n).base_node])
+                above.push_back(n);
+        if (above.empty() || tree.split_many(above) == 0) break;
+    }
+    std::vector<NodeStats> stats(tree.node_count());
     const size_t base_nodes = asset.bvh().nodes.size();
 
     // cuts[0]: the current cut (statistics); then the registered coarser LoDs.

@@ -54,7 +54,8 @@ void TrainingCut::assign(std::span<const uint32_t> leaf_nodes, size_t base_node_
 }
 
 FirstLeaf first_leaf_of_cut(const Bvh& base, std::span<const Aabb> node_boxes, const TrainingCut& cut,
-                            const glm::vec3& origin, const glm::vec3& dir, float dilation, float min_exit) {
+                            const glm::vec3& origin, const glm::vec3& dir, float dilation, float min_exit,
+                            uint32_t root) {
     FirstLeaf best;
     if (base.nodes.empty()) return best;
     float best_entry = NB_INF;
@@ -65,8 +66,9 @@ FirstLeaf first_leaf_of_cut(const Bvh& base, std::span<const Aabb> node_boxes, c
     Entry stack[NB_BVH_MAX_DEPTH * 2 + 2];
     int top = 0;
     float t0, t1;
-    if (!clip_line_to_box(origin, dir, dilate_box(node_boxes[0], dilation), t0, t1) || t1 <= min_exit) return best;
-    stack[top++] = {0u, t0};
+    NBVH_CHECK(root < base.nodes.size());
+    if (!clip_line_to_box(origin, dir, dilate_box(node_boxes[root], dilation), t0, t1) || t1 <= min_exit) return best;
+    stack[top++] = {root, t0};
     while (top > 0) {
         const Entry e = stack[--top];
         if (e.t_entry >= best_entry) continue; // an earlier leaf was already found

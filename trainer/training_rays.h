@@ -66,9 +66,10 @@ struct FirstLeaf {
     float t_exit = 0.0f;
 };
 
-// Nearest-first descent of the base BVH, stopping at cut leaves. `node_boxes` are the (regularised)
-// boxes per base node, `dilation` is relative to each box's extent.
+// Nearest-first descent of the base BVH from `root` (a part's subtree, training_asset.h), stopping at cut
+// leaves. `node_boxes` are the (regularised) boxes per base node, `dilation` is relative to each box's extent.
 FirstLeaf first_leaf_of_cut(const Bvh& base, std::span<const Aabb> node_boxes, const TrainingCut& cut,
-                            const glm::vec3& origin, const glm::vec3& dir, float dilation, float min_exit);
+                            const glm::vec3& origin, const glm::vec3& dir, float dilation, float min_exit,
+                            uint32_t root = 0);
 
 } // namespace nbvh

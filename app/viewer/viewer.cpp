@@ -141,10 +141,10 @@ void run_viewer(const ViewerArgs& a) {
 
     SceneLoadOptions lo;
     lo.neural_glob = a.neural_glob;
-    const Scene scene = app::load_scene_arg(a.scene, lo);
     NeuralModel model;
     const bool has_model = !a.model.empty();
     if (has_model) model = load_model(a.model);
+    const Scene scene = app::load_scene_for_model(a.scene, lo, has_model ? &model : nullptr, a.model);
     const Environment env = choose_environment(scene, a.env);
     uint32_t fb_w = 0, fb_h = 0;
     window.framebuffer_size(&fb_w, &fb_h);

@@ -48,6 +48,13 @@ Bvh build_bvh(std::span<const Aabb> prim_bounds, const BvhBuildOptions& options 
 // Pads node bounds thinner than `min_extent` (see BvhBuildOptions::min_node_extent) in place.
 void pad_node_bounds(Bvh& bvh, float min_extent);
 
+// One BVH over several parts (the multi-asset training BVH, trainer/training_asset.h): a SAH tree over the
+// parts' root boxes whose leaves are the parts' own trees, so every part is one subtree. Part p's
+// primitive ids are shifted by prim_offsets[p]; part_roots (when given) receives the node index of each
+// part's root. Node invariants of build_bvh hold (children adjacent, after their parent). Throws
+// nbvh::Error when a part is empty or the joined tree would be deeper than NB_BVH_MAX_DEPTH.
+Bvh join_bvhs(std::span<const Bvh> parts, std::span<const uint32_t> prim_offsets,
+              std::vector<uint32_t>* part_roots = nullptr);
 // Two-child GPU layout; leaf references index `prim_indices` order (callers reorder their primitive
 // arrays by prim_indices so that a leaf's items are contiguous).
 std::vector<GpuBvhNode> to_gpu_layout(const Bvh& bvh);

@@ -130,8 +130,8 @@ NeuralModel parse_model(std::span<const uint8_t> bytes, const std::string& name)
     model_io::Reader h(bytes.subspan(0, model_io::HEADER_BYTES), name + ": header");
     h.skip(4);
     const uint32_t version = h.u32();
-    if (version != MODEL_FORMAT_VERSION)
-        throw fail(strfmt("unsupported model format version %u (this build reads version %u)", version,
+    if (version == 0 || version > MODEL_FORMAT_VERSION)
+        throw fail(strfmt("unsupported model format version %u (this build reads versions 1 to %u)", version,
                           MODEL_FORMAT_VERSION));
     const uint32_t section_count = h.u32();
     if (h.u32() != 0) throw fail("header: reserved field is not zero");
@@ -174,7 +174,7 @@ NeuralModel parse_model(std::span<const uint8_t> bytes, const std::string& name)
         if (sorted[i].bytes.data() < sorted[i - 1].bytes.data() + sorted[i - 1].bytes.size())
             throw fail("sections '" + model_io::id_string(sorted[i - 1].id) + "' and '" +
                        model_io::id_string(sorted[i].id) + "' overlap");
-    return model_io::decode_sections(views, name);
+    return model_io::decode_sections(views, name, version);
 }
 
 NeuralModel load_model(const std::filesystem::path& path) {

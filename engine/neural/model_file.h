@@ -19,7 +19,8 @@
 
 namespace nbvh {
 
-inline constexpr uint32_t MODEL_FORMAT_VERSION = 1;
+inline constexpr uint32_t MODEL_FORMAT_VERSION = 2;     // written; version 1 (one unnamed asset) still reads
+inline constexpr uint32_t MODEL_MAX_ASSETS = 65536;
 inline constexpr size_t MODEL_MAX_STRING = 4096; // bytes of a name in the file
 
 struct TrainingMetadata {
@@ -38,11 +39,27 @@ struct TrainingMetadata {
     float split_scaling = 0.0f, split_interval_scaling = 0.0f;
 };
 
+// One neural asset of the model (ARCHITECTURE.md "Which assets are neural"): a unique (mesh, material)
+// of the scene, its own subtree of the N-BVH, placed in the shared encoding ("atlas") space by a
+// uniform scale and an offset (trainer/training_asset.h TrainingPart). Instances share it.
+struct ModelAsset {
+    std::string name;                    // the scene mesh it answers (after the split by material)
+    std::string mesh;                    // glTF mesh it comes from
+    std::string material;                // glTF material name ("" in version-1 files)
+    std::vector<std::string> node_paths; // glTF nodes it was trained for (information)
+    uint64_t geometry_hash = 0;          // asset_table.h geometry_fingerprint; 0 = unknown (version 1)
+    uint64_t material_hash = 0;          // asset_table.h material_fingerprint; 0 = unknown
+    uint32_t root = 0;                   // N-BVH node of its subtree
+    uint32_t triangles = 0;
+    float scale = 1.0f;                  // atlas = object * scale + offset
+    glm::vec3 offset{0.0f};
+};
+
 struct NeuralModel {
     NeuralConfig cfg;
     std::vector<GpuHashLevel> levels;    // as stored: readers use this table, never recompute it
-    std::string asset_name;              // glTF mesh/node name of the neural asset
-    Aabb encoding_box;                   // object-space box the encoding normalises by (extent > 0)
+    std::vector<ModelAsset> assets;      // at least one; subtrees disjoint
+    Aabb encoding_box;                   // atlas-space box the encoding normalises by (extent > 0)
     uint32_t lod_count = 1;
     std::vector<NbvhNode> nodes;         // stored fields: bounds, left, base_node, lod, final_leaf
     std::vector<uint32_t> lod_node_counts; // nodes reached walking LoD l (index l), lod_count entries

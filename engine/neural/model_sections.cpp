@@ -139,7 +139,21 @@ std::vector<Section> encode_sections(const NeuralModel& m) {
         Writer w(b);
         for (int k = 0; k < 3; ++k) w.f32(m.encoding_box.lo[k]);
         for (int k = 0; k < 3; ++k) w.f32(m.encoding_box.hi[k]);
-        w.str(m.asset_name);
+        w.u32(uint32_t(m.assets.size()));
+        w.u32(0);
+        for (const ModelAsset& a : m.assets) {
+            w.str(a.name);
+            w.str(a.mesh);
+            w.str(a.material);
+            w.u32(uint32_t(a.node_paths.size()));
+            for (const std::string& p : a.node_paths) w.str(p);
+            w.u64(a.geometry_hash);
+            w.u64(a.material_hash);
+            w.u32(a.root);
+            w.u32(a.triangles);
+            w.f32(a.scale);
+            for (int k = 0; k < 3; ++k) w.f32(a.offset[k]);
+        }
         out.push_back(make(ID_ASSET, std::move(b)));
     }
     {
@@ -209,7 +223,77 @@ std::vector<Section> encode_sections(const NeuralModel& m) {
     return out;
 }
 
-NeuralModel decode_sections(const std::vector<SectionView>& sections, const std::string& name) {
+namespace {
+
+// Version 2: u32 count, u32 0, then per asset: str name, str mesh, str material, u32 path count + strs,
+// u64 geometry hash, u64 material hash, u32 root, u32 triangles, f32 scale, f32[3] offset.
+// Version 1: one asset named by a single string (root 0, identity placement, hashes unknown).
+void read_assets(Reader& r, uint32_t version, NeuralModel& m) {
+    if (version == 1) {
+        ModelAsset a;
+        a.name = a.mesh = r.str("asset name");
+        m.assets.push_back(a);
+        return;
+    }
+    constexpr size_t MIN_ASSET_BYTES = 3 * 4 + 4 + 8 + 8 + 4 + 4 + 16;
+    const uint32_t count = r.u32();
+    if (r.u32() != 0) throw Error(r.where() + ": reserved field is not zero");
+    if (count == 0 || count > MODEL_MAX_ASSETS || count > r.remaining() / MIN_ASSET_BYTES)
+        throw Error(strfmt("%s: asset count %u out of range", r.where().c_str(), count));
+    m.assets.resize(count);
+    for (ModelAsset& a : m.assets) {
+        a.name = r.str("asset name");
+        a.mesh = r.str("asset mesh");
+        a.material = r.str("asset material");
+        const uint32_t paths = r.u32();
+        if (paths > r.remaining() / 4) throw Error(strfmt("%s: node path count %u exceeds the section", r.where().c_str(), paths));
+        for (uint32_t i = 0; i < paths; ++i) a.node_paths.push_back(r.str("node path"));
+        a.geometry_hash = r.u64();
+        a.material_hash = r.u64();
+        a.root = r.u32();
+        a.triangles = r.u32();
+        a.scale = r.f32();
+        for (int k = 0; k < 3; ++k) a.offset[k] = r.f32();
+        if (!(a.scale > 0.0f) || !std::isfinite(a.scale) || !finite3(a.offset))
+            throw Error(strfmt("%s: asset '%s' has a non-finite or non-positive placement", r.where().c_str(),
+                               a.name.c_str()));
+    }
+}
+
+} // namespace
+
+void validate_assets(const NeuralModel& m, const std::string& name) {
+    if (m.assets.empty() || m.assets.size() > MODEL_MAX_ASSETS)
+        throw Error(strfmt("%s: asset count %zu out of range", name.c_str(), m.assets.size()));
+    // Roots: valid nodes whose subtrees are disjoint (no root at or below another).
+    std::vector<int32_t> owner(m.nodes.size(), -1);
+    for (size_t i = 0; i < m.assets.size(); ++i) {
+        const ModelAsset& a = m.assets[i];
+        if (a.root >= m.nodes.size())
+            throw Error(strfmt("%s: asset '%s' root %u is not a node", name.c_str(), a.name.c_str(), a.root));
+        if (owner[a.root] >= 0)
+            throw Error(strfmt("%s: assets '%s' and '%s' share a root", name.c_str(),
+                               m.assets[size_t(owner[a.root])].name.c_str(), a.name.c_str()));
+        owner[a.root] = int32_t(i);
+        if (!(a.scale > 0.0f) || !std::isfinite(a.scale) || !finite3(a.offset))
+            throw Error(strfmt("%s: asset '%s' has a non-finite or non-positive placement", name.c_str(), a.name.c_str()));
+        for (size_t j = 0; j < i; ++j)
+            if (m.assets[j].name == a.name)
+                throw Error(strfmt("%s: asset name '%s' appears twice", name.c_str(), a.name.c_str()));
+    }
+    // Parents come before children: one pass propagates ownership downwards; meeting a second root
+    // below an owned node means nested subtrees.
+    for (size_t i = 1; i < m.nodes.size(); ++i) {
+        const uint32_t p = m.nodes[i].parent;
+        if (p == NBVH_NO_CHILD || p >= m.nodes.size() || owner[p] < 0) continue;
+        if (owner[i] >= 0)
+            throw Error(strfmt("%s: asset '%s' lies inside asset '%s'", name.c_str(),
+                               m.assets[size_t(owner[i])].name.c_str(), m.assets[size_t(owner[p])].name.c_str()));
+        owner[i] = owner[p];
+    }
+}
+
+NeuralModel decode_sections(const std::vector<SectionView>& sections, const std::string& name, uint32_t version) {
     auto find = [&](const char id[4]) -> Reader {
         for (const SectionView& s : sections)
             if (std::memcmp(s.id, id, 4) == 0) return Reader(s.bytes, name + ": section '" + id_string(id) + "'");
@@ -238,7 +322,7 @@ NeuralModel decode_sections(const std::vector<SectionView>& sections, const std:
         Reader r = find(ID_ASSET);
         for (int k = 0; k < 3; ++k) m.encoding_box.lo[k] = r.f32();
         for (int k = 0; k < 3; ++k) m.encoding_box.hi[k] = r.f32();
-        m.asset_name = r.str("asset name");
+        read_assets(r, version, m);
         expect_end(r);
         if (!finite3(m.encoding_box.lo) || !finite3(m.encoding_box.hi))
             throw Error(r.where() + ": encoding box is not finite");
@@ -343,6 +427,7 @@ NeuralModel decode_sections(const std::vector<SectionView>& sections, const std:
             !std::isfinite(t.split_scaling) || !std::isfinite(t.split_interval_scaling))
             throw Error(r.where() + ": training metadata holds a non-finite or negative number");
     }
+    validate_assets(m, name);
     return m;
 }
 

@@ -90,7 +90,9 @@ inline std::string id_string(const char id[4]) {
 uint64_t header_checksum(const uint8_t* file, size_t section_count);
 
 std::vector<Section> encode_sections(const NeuralModel& model);
-NeuralModel decode_sections(const std::vector<SectionView>& sections, const std::string& name);
+NeuralModel decode_sections(const std::vector<SectionView>& sections, const std::string& name, uint32_t version);
+// The asset table against the nodes (parents derived): roots valid and subtrees disjoint, names unique.
+void validate_assets(const NeuralModel& model, const std::string& name);
 
 // Structure of an untrusted node array (children after parents, adjacent, each node referenced once,
 // LoD codes in range, finite bounds, depth within the GPU stack). Throws nbvh::Error.

@@ -148,19 +148,20 @@ std::vector<uint32_t> NbvhTree::leaves_at(uint32_t lod) const {
     return out;
 }
 
-std::vector<GpuBvhNode> NbvhTree::to_gpu_layout(uint32_t lod) const {
+std::vector<GpuBvhNode> NbvhTree::to_gpu_layout(uint32_t lod, uint32_t root) const {
     std::vector<GpuBvhNode> gpu;
     if (nodes_.empty()) return gpu;
-    if (is_leaf_at(0, lod)) {
+    NBVH_CHECK(root < nodes_.size());
+    if (is_leaf_at(root, lod)) {
         GpuBvhNode g = empty_gpu_node();
-        g.lmin = nodes_[0].bounds.lo; g.lmax = nodes_[0].bounds.hi;
-        g.left = nb_make_leaf(0, 1);
+        g.lmin = nodes_[root].bounds.lo; g.lmax = nodes_[root].bounds.hi;
+        g.left = nb_make_leaf(root, 1);
         gpu.push_back(g);
         return gpu;
     }
     // Depth-first, left subtree first, so a GPU node's left child (when interior) is the next node.
     struct Item { uint32_t node; uint32_t gpu_parent; bool is_right; };
-    std::vector<Item> stack{{0, NB_CHILD_NONE, false}};
+    std::vector<Item> stack{{root, NB_CHILD_NONE, false}};
     while (!stack.empty()) {
         const Item it = stack.back();
         stack.pop_back();

@@ -86,7 +86,8 @@ public:
     // Two-child GPU layout of the cut of `lod`: one GpuBvhNode per interior node of that cut, root first;
     // leaf references are nb_make_leaf(N-BVH node index, 1). A tree whose root is a leaf gives one GPU
     // node with the root as its left child and an empty right child.
-    std::vector<GpuBvhNode> to_gpu_layout(uint32_t lod) const;
+    // `root`: the subtree of that node only (one asset of a multi-asset model); its first GPU node is its root.
+    std::vector<GpuBvhNode> to_gpu_layout(uint32_t lod, uint32_t root = 0) const;
 
 private:
     void derive_links();

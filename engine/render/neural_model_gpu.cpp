@@ -105,12 +105,14 @@ void pack_lod_nodes(const NeuralModel& model, std::vector<GpuBvhNode>& nodes, st
     roots.clear();
     const NbvhTree tree = model.tree();
     for (uint32_t lod = 0; lod < std::max(1u, model.lod_count); ++lod) {
-        const uint32_t base = uint32_t(nodes.size());
-        roots.push_back(base);
-        for (GpuBvhNode n : tree.to_gpu_layout(lod)) {
-            if (n.left != NB_CHILD_NONE && !nb_is_leaf(n.left)) n.left += base;
-            if (n.right != NB_CHILD_NONE && !nb_is_leaf(n.right)) n.right += base;
-            nodes.push_back(n);
+        for (const ModelAsset& a : model.assets) {
+            const uint32_t base = uint32_t(nodes.size());
+            roots.push_back(base);
+            for (GpuBvhNode n : tree.to_gpu_layout(lod, a.root)) {
+                if (n.left != NB_CHILD_NONE && !nb_is_leaf(n.left)) n.left += base;
+                if (n.right != NB_CHILD_NONE && !nb_is_leaf(n.right)) n.right += base;
+                nodes.push_back(n);
+            }
         }
     }
 }
@@ -131,6 +133,7 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
     mlp_t_ = vk::make_buffer(ctx, pack_halves(transpose_mlp(model.mlp)), "neural mlp transposed");
     std::vector<GpuBvhNode> nodes;
     pack_lod_nodes(model, nodes, roots_);
+    asset_count_ = uint32_t(model.assets.size());
     nodes_ = vk::make_buffer(ctx, nodes, "nbvh nodes");
     std::vector<glm::vec3> bounds;
     bounds.reserve(model.nodes.size() * 2);
@@ -143,9 +146,9 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
     bytes_ = levels_.size() + grid_.size() + mlp_.size() + mlp_t_.size() + nodes_.size() + leaf_bounds_.size();
 }
 
-uint32_t NeuralModelGpu::lod_root(uint32_t lod) const {
-    NBVH_CHECK(!roots_.empty());
-    return roots_[std::min<size_t>(lod, roots_.size() - 1)];
+uint32_t NeuralModelGpu::lod_root(uint32_t lod, uint32_t asset) const {
+    NBVH_CHECK(!roots_.empty() && asset < asset_count_);
+    return roots_[size_t(std::min(lod, lod_count() - 1)) * asset_count_ + asset];
 }
 
 const char* coopmat_fp32_shader(const char* kind) {

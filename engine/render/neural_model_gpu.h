@@ -49,8 +49,9 @@ const char* coopmat_fp32_shader(const char* kind);
 // Host-side packing (pure CPU, unit-testable).
 std::vector<uint32_t> pack_halves(const std::vector<uint16_t>& halves); // pairs -> words (low = even)
 GpuEncodingBox encoding_box_of(const NeuralModel& model);
-// Nodes of every LoD concatenated; roots[l] = first node of LoD l. Interior refs are offset so each
-// LoD's nodes index the concatenated array; leaf refs keep N-BVH node indices.
+// Nodes of every LoD and asset concatenated (the subtree of each asset root, model.assets order);
+// roots[l * assets + a] = first node of asset a's cut at LoD l. Interior refs are offset so they index
+// the concatenated array; leaf refs keep N-BVH node indices.
 void pack_lod_nodes(const NeuralModel& model, std::vector<GpuBvhNode>& nodes, std::vector<uint32_t>& roots);
 // The weights with every matrix transposed and cut into 16x16 tiles (same matrix offsets as mlp.h;
 // element (input c, output r) at nb_coop_weight_slot): each B = W^T tile the cooperative-matrix kernels
@@ -70,8 +71,9 @@ public:
     const vk::Buffer& nodes() const { return nodes_; }      // GpuBvhNode, all LoDs
     const vk::Buffer& leaf_bounds() const { return leaf_bounds_; } // vec3 lo, vec3 hi per N-BVH node
     const GpuEncodingBox& box() const { return box_; }
-    uint32_t lod_count() const { return uint32_t(roots_.size()); }
-    uint32_t lod_root(uint32_t lod) const; // clamps lod to the coarsest
+    uint32_t lod_count() const { return asset_count_ ? uint32_t(roots_.size()) / asset_count_ : 0u; }
+    uint32_t asset_count() const { return asset_count_; }
+    uint32_t lod_root(uint32_t lod, uint32_t asset = 0) const; // clamps lod to the coarsest
     uint64_t bytes() const { return bytes_; }
     // Hands the buffers to a renderer that binds them by slot (this object keeps box and roots).
     void move_into(vk::Buffer& levels, vk::Buffer& grid, vk::Buffer& mlp, vk::Buffer& mlp_t, vk::Buffer& nodes,
@@ -88,6 +90,7 @@ private:
     vk::Buffer levels_, grid_, mlp_, mlp_t_, nodes_, leaf_bounds_;
     GpuEncodingBox box_{};
     std::vector<uint32_t> roots_;
+    uint32_t asset_count_ = 0;
     uint64_t bytes_ = 0;
 };
 

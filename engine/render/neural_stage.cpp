@@ -28,8 +28,8 @@ uint32_t effective_leaves_per_round(const NeuralRenderOptions& o) {
 
 void validate(const NeuralRenderOptions& o, const Scene& scene) {
     effective_leaves_per_round(o);
-    if (!(o.roughness >= 0.0f && o.roughness <= 1.0f)) throw Error("--neural-roughness must be in [0, 1]");
-    if (!(o.metallic >= 0.0f && o.metallic <= 1.0f)) throw Error("--neural-metallic must be in [0, 1]");
+    if (!(o.roughness <= 1.0f)) throw Error("--neural-roughness must be in [0, 1]");
+    if (!(o.metallic <= 1.0f)) throw Error("--neural-metallic must be in [0, 1]");
     if (o.max_rounds == 0 || o.max_rounds > 256) throw Error("--neural-max-leaves must be in 1..256");
     if (o.batched_rounds > 256) throw Error("--neural-batched-rounds must be in 0..256");
     if (!(o.threshold > 0.0f && o.threshold < 1.0f)) throw Error("the visibility threshold must be in (0, 1)");
@@ -45,13 +45,40 @@ void validate(const NeuralRenderOptions& o, const Scene& scene) {
     }
 }
 
-uint32_t mark_neural_instances(const Scene& scene, GpuSceneData& data) {
+int32_t asset_of_mesh(const NeuralModel& model, const Scene& scene, uint32_t mesh) {
+    if (mesh >= scene.meshes.size()) return -1;
+    for (size_t a = 0; a < model.assets.size(); ++a)
+        if (model.assets[a].name == scene.meshes[mesh].name) return int32_t(a);
+    const bool legacy = model.assets.size() == 1 && model.assets[0].material.empty(); // version 1
+    return legacy ? 0 : -1;
+}
+
+namespace {
+void rows_of(const glm::mat4& m, vec4 rows[3]) {
+    for (int r = 0; r < 3; ++r) rows[r] = vec4(m[0][r], m[1][r], m[2][r], m[3][r]);
+}
+} // namespace
+
+uint32_t mark_neural_instances(const Scene& scene, const SceneAccel& accel, const NeuralModel& model, GpuSceneData& data) {
     uint32_t n = 0;
     for (size_t gi = 0; gi < data.instance_to_scene.size() && gi < data.instances.size(); ++gi) {
-        if (scene.instances[data.instance_to_scene[gi]].neural) {
-            data.instances[gi].kind = NB_INSTANCE_NEURAL;
-            ++n;
-        }
+        const uint32_t si = data.instance_to_scene[gi];
+        const Instance& inst = scene.instances[si];
+        if (!inst.neural) continue;
+        const int32_t a = asset_of_mesh(model, scene, inst.mesh);
+        if (a < 0)
+            throw Error(strfmt("neural node '%s' (mesh '%s') has no asset in the model", inst.name.c_str(),
+                               scene.meshes[inst.mesh].name.c_str()));
+        const ModelAsset& asset = model.assets[size_t(a)];
+        // atlas = object * scale + offset (trainer/training_asset.h): composed into the instance.
+        glm::mat4 to_atlas(asset.scale);
+        to_atlas[3] = glm::vec4(asset.offset, 1.0f);
+        GpuInstance& g = data.instances[gi];
+        rows_of(to_atlas * accel.world_to_object[si], g.world_to_object);
+        rows_of(accel.object_to_world[si] * glm::inverse(to_atlas), g.object_to_world);
+        g.kind = NB_INSTANCE_NEURAL;
+        g.blas_root = uint32_t(a);
+        ++n;
     }
     return n;
 }
@@ -70,8 +97,8 @@ void apply_classical_materials(const Scene& scene, GpuSceneData& data, float rou
             auto it = copy_of.find(m);
             if (it == copy_of.end()) {
                 GpuMaterial c = data.materials[m];
-                c.roughness = roughness;
-                c.metallic = metallic;
+                if (roughness >= 0.0f) c.roughness = roughness;
+                if (metallic >= 0.0f) c.metallic = metallic;
                 c.metallic_roughness_tex.texture = -1;
                 c.transmission = 0.0f;
                 it = copy_of.emplace(m, uint32_t(data.materials.size())).first;
@@ -82,8 +109,8 @@ void apply_classical_materials(const Scene& scene, GpuSceneData& data, float rou
     }
 }
 
-NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const NeuralRenderOptions& o,
-                         uint32_t ray_capacity)
+NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const Scene& scene,
+                         const NeuralRenderOptions& o, uint32_t ray_capacity)
     : ctx_(ctx), model_(ctx, model), kernel_(choose_neural_kernel(ctx.features(), o.path)),
       rounds_(o.max_rounds), capacity_(ray_capacity) {
     params_.leaves_per_round = effective_leaves_per_round(o);
@@ -92,10 +119,24 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
     const uint32_t needed = (o.max_rounds + params_.leaves_per_round - 1) / params_.leaves_per_round;
     batched_ = std::min(needed, o.batched_rounds);
     params_.box = model_.box();
-    params_.root_primary = model_.lod_root(o.lod);
-    params_.root_secondary = model_.lod_root(o.secondary_lod < 0 ? o.lod : uint32_t(o.secondary_lod));
-    params_.roughness = o.roughness;
-    params_.metallic = o.metallic;
+    params_.lod_primary = std::min(o.lod, model_.lod_count() - 1);
+    params_.lod_secondary = std::min(o.secondary_lod < 0 ? o.lod : uint32_t(o.secondary_lod), model_.lod_count() - 1);
+    params_.roughness = o.roughness < 0.0f ? -1.0f : o.roughness;
+    params_.metallic = o.metallic < 0.0f ? -1.0f : o.metallic;
+    // The asset table: each asset's subtree root per LoD (LoDs past the model's repeat its coarsest) and
+    // the material of the scene mesh it answers (one material per asset after bind_model_to_scene).
+    assets_.resize(model.assets.size());
+    for (uint32_t a = 0; a < assets_.size(); ++a) {
+        GpuNeuralAsset& g = assets_[a];
+        for (uint32_t l = 0; l < NB_NEURAL_MAX_LODS; ++l) g.roots[l] = model_.lod_root(l, a);
+        g.material = 0;
+        for (uint32_t m = 0; m < scene.meshes.size(); ++m)
+            if (asset_of_mesh(model, scene, m) == int32_t(a) && !scene.meshes[m].triangle_material.empty()) {
+                g.material = scene.meshes[m].triangle_material[0];
+                break;
+            }
+        if (g.material >= std::max<size_t>(scene.materials.size(), 1)) g.material = 0;
+    }
     params_.threshold = o.threshold;
     params_.max_rounds = o.max_rounds;
 }
@@ -117,6 +158,7 @@ void NeuralStage::install(std::vector<vk::Buffer>& buffers) {
     buffers[NB_BIND_NEURAL_STATE] = vk::Buffer(ctx_, 2ull * std::max(capacity_, 1u) * sizeof(GpuNeuralRayState),
                                                vk::MemoryKind::device, 0, "neural ray state");
     buffers[NB_BIND_NEURAL_PARAMS] = vk::make_buffer(ctx_, std::vector<GpuNeuralParams>{params_}, "neural params");
+    buffers[NB_BIND_NEURAL_ASSETS] = vk::make_buffer(ctx_, assets_, "neural assets");
     buffers[NB_BIND_NEURAL_COUNTERS] =
         vk::Buffer(ctx_, sizeof(GpuNeuralCounters), vk::MemoryKind::device, 0, "neural counters");
     buffers[NB_BIND_PENDING_LEAVES].fill(0u);

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/bvh/scene_accel.h"
 #include "engine/neural/model_file.h"
 #include "engine/render/gpu_scene.h"
 #include "engine/render/neural_model_gpu.h"
@@ -28,12 +29,14 @@ namespace nbvh::render {
 
 struct NeuralRenderOptions {
     const NeuralModel* model = nullptr; // hybrid render when set (and not classical)
-    bool classical = false;             // reference: neural instances as triangles, neural material constants
+    bool classical = false;             // reference: neural instances as triangles (the true scene)
     NeuralPath path = NeuralPath::automatic;
     uint32_t lod = 0;                   // N-BVH cut of camera rays (0 = finest)
     int32_t secondary_lod = -1;         // cut after the first hit (-1: same as lod)
-    float roughness = 0.5f;             // material constants of neural surfaces
-    float metallic = 0.0f;
+    // Explicit overrides of the neural surfaces' material (< 0: the asset's glTF material). When set they
+    // apply to the classical reference too, so both renders shade alike.
+    float roughness = -1.0f;
+    float metallic = -1.0f;
     // Leaves queried per ray at most (then the closest hit so far is kept). 8: on the default scene at
     // 1080p, 16 -> 8 -> 6 leaves changed FLIP against the classical reference by < 1e-4 (H200 v3/v4).
     uint32_t max_rounds = 8;
@@ -56,15 +59,20 @@ uint32_t effective_leaves_per_round(const NeuralRenderOptions& options);
 // LoDs beyond the model's, a model with no neural instance in the scene).
 void validate(const NeuralRenderOptions& options, const Scene& scene);
 
-// Marks instances flagged neural as NB_INSTANCE_NEURAL (hybrid render). Returns how many.
-uint32_t mark_neural_instances(const Scene& scene, GpuSceneData& data);
-// Classical reference: neural meshes' triangles get copies of their materials with the neural
-// roughness/metallic (and no transmission), so both renders shade with the same constants.
+// The model's asset for scene mesh `mesh` (by name, after bind_model_to_scene; a version-1 model's one
+// asset answers every neural mesh), or -1.
+int32_t asset_of_mesh(const NeuralModel& model, const Scene& scene, uint32_t mesh);
+// Marks instances flagged neural as NB_INSTANCE_NEURAL (hybrid render): blas_root becomes the asset
+// index, the transforms map world <-> the model's atlas space. Returns how many. Throws nbvh::Error for
+// a neural instance whose mesh has no asset in the model.
+uint32_t mark_neural_instances(const Scene& scene, const SceneAccel& accel, const NeuralModel& model, GpuSceneData& data);
+// Classical reference with explicit overrides: neural meshes' triangles get copies of their materials
+// with the override roughness/metallic (< 0: unchanged) and no transmission.
 void apply_classical_materials(const Scene& scene, GpuSceneData& data, float roughness, float metallic);
 
 class NeuralStage {
 public:
-    NeuralStage(const vk::Context& ctx, const NeuralModel& model, const NeuralRenderOptions& options,
+    NeuralStage(const vk::Context& ctx, const NeuralModel& model, const Scene& scene, const NeuralRenderOptions& options,
                 uint32_t ray_capacity);
 
     // Moves the neural buffers into `buffers` (indexed by binding, resized to NB_NEURAL_BINDING_END):
@@ -85,6 +93,7 @@ private:
     NeuralModelGpu model_;
     NeuralKernelChoice kernel_;
     GpuNeuralParams params_{};
+    std::vector<GpuNeuralAsset> assets_;
     uint32_t rounds_ = 0;
     uint32_t batched_ = 0;
     uint32_t capacity_ = 0;

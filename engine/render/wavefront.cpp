@@ -79,9 +79,10 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     // (classical reference); without either they render as plain triangles.
     const NeuralRenderOptions& nopt = options_.neural;
     if (nopt.model || nopt.classical) validate(nopt, scene);
-    if (nopt.classical) apply_classical_materials(scene, data_, nopt.roughness, nopt.metallic);
+    if (nopt.classical && (nopt.roughness >= 0.0f || nopt.metallic >= 0.0f))
+        apply_classical_materials(scene, data_, nopt.roughness, nopt.metallic);
     const bool hybrid = nopt.model && !nopt.classical;
-    if (hybrid) features_.neural = mark_neural_instances(scene, data_) > 0;
+    if (hybrid) features_.neural = mark_neural_instances(scene, accel, *nopt.model, data_) > 0;
     if (features_.emission && data_.lights.size() == 1 && data_.light_total_power <= 0.0f) features_.emission = false;
 
     // Per-render parameters.
@@ -133,7 +134,7 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
         vk::Buffer(ctx_, sizeof(GpuPendingLeaf), vk::MemoryKind::device, 0, "pending leaves");
     NeuralStage::install_placeholders(ctx_, buffers_);
     if (features_.neural) {
-        neural_ = std::make_unique<NeuralStage>(ctx_, *nopt.model, nopt, capacity_);
+        neural_ = std::make_unique<NeuralStage>(ctx_, *nopt.model, scene, nopt, capacity_);
         neural_->install(buffers_);
     }
     buffers_[NB_BIND_OUTPUT] = vk::Buffer(ctx_, pixels * sizeof(vec4), vk::MemoryKind::device, 0, "output");

@@ -57,6 +57,7 @@ struct Material {
 // carries its material. Invalid triangles (non-finite, out-of-range indices) were dropped by the loader.
 struct Mesh {
     std::string name;
+    std::string split_from;           // glTF mesh this one was cut from by material (neural assets), or ""
     std::vector<glm::vec3> positions;
     std::vector<glm::vec3> normals;   // always present (generated when missing), unit length
     std::vector<glm::vec4> tangents;  // empty unless a material of this mesh uses a normal map

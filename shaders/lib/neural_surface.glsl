@@ -1,7 +1,9 @@
-// The shading surface of a neural hit (issue 4): position on the ray, the predicted normal (world space,
-// turned towards the incoming ray, used as geometric and shading normal), the predicted albedo as base
-// colour, and the user's material constants (--neural-roughness, --neural-metallic). Included by
-// passes/shade.comp after lib/material.glsl.
+// The shading surface of a neural hit: position on the ray, the predicted normal (world space, turned
+// towards the incoming ray, used as geometric and shading normal), the predicted albedo as base colour
+// (it learned factor x texture), and the rest from the asset's glTF material: metallic, roughness,
+// transmission and emission factors (no textures: a neural hit has no uv), unless the user overrides
+// metallic/roughness (--neural-metallic, --neural-roughness). Included by passes/shade.comp after
+// lib/material.glsl.
 #ifndef NB_NEURAL_SURFACE_GLSL
 #define NB_NEURAL_SURFACE_GLSL
 #include "lib/neural_bindings.glsl"
@@ -9,7 +11,9 @@
 Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t) {
     GpuNeuralRayState st = neural_state[ray];
     Surface s;
-    s.material = 0u;
+    GpuNeuralAsset asset = neural_assets[instances[st.instance].blas_root];
+    GpuMaterial m = materials[asset.material];
+    s.material = asset.material;
     s.p = ray_org + ray_dir * t;
     vec3 n = st.normal;
     if (!(dot(n, n) > 0.0f)) n = -ray_dir;
@@ -17,10 +21,13 @@ Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t) {
     s.ng = n;
     s.n = n;
     s.base = clamp(st.albedo, 0.0f, 1.0f);
-    s.metallic = clamp(neural_params.metallic, 0.0f, 1.0f);
-    s.alpha = nb_ggx_alpha(clamp(neural_params.roughness, 0.0f, 1.0f));
-    s.transmission = 0.0f;
-    s.emission = vec3(0.0f);
+    float metallic = neural_params.metallic < 0.0f ? m.metallic : neural_params.metallic;
+    float roughness = neural_params.roughness < 0.0f ? m.roughness : neural_params.roughness;
+    s.metallic = clamp(metallic, 0.0f, 1.0f);
+    s.alpha = nb_ggx_alpha(clamp(roughness, 0.0f, 1.0f));
+    bool from_material = neural_params.metallic < 0.0f && neural_params.roughness < 0.0f;
+    s.transmission = (NB_HAS_TRANSMISSION && from_material) ? clamp(m.transmission, 0.0f, 1.0f) * (1.0f - s.metallic) : 0.0f;
+    s.emission = NB_HAS_EMISSION ? m.emissive : vec3(0.0f);
     return s;
 }
 

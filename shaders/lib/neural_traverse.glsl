@@ -15,7 +15,7 @@
 #include "lib/neural_bindings.glsl"
 
 bool g_nl_skip_triangles = false; // resumed rounds: the triangle hit of round 0 is already known
-uint g_nl_root = 0u;              // N-BVH cut (LoD) root of this ray
+uint g_nl_lod = 0u;               // N-BVH cut (LoD) of this ray
 float g_nl_last_t = -NB_INF;      // last queued key (exclusive lower bound)
 uint g_nl_last_inst = 0u;
 uint g_nl_last_leaf = 0u;
@@ -76,6 +76,8 @@ void nb_neural_leaf(uint first, uint count) {
 
 void nb_traverse_neural_instance(uint instance) {
     GpuInstance inst = instances[instance];
+    // A neural instance's blas_root is its asset; its world_to_object maps into the model's atlas space.
+    uint root = neural_assets[inst.blas_root].roots[g_nl_lod];
     g_nl_inst = instance;
     g_cur_instance = instance;
     g_obj_org = nb_xform_point(inst.world_to_object, g_org);
@@ -85,7 +87,7 @@ void nb_traverse_neural_instance(uint instance) {
     // triangles are culled by hits only).
     float saved_tmax = g_tmax;
     g_tmax = min(g_tmax, nb_nl_bound_t());
-    NB_TRAVERSE_BVH(nbvh_nodes, g_nl_root, g_obj_org, g_nl_inv_dir, nb_neural_leaf)
+    NB_TRAVERSE_BVH(nbvh_nodes, root, g_obj_org, g_nl_inv_dir, nb_neural_leaf)
     g_tmax = saved_tmax;
 }
 
@@ -154,8 +156,8 @@ void nb_nl_reduce_group(uint slot, uint group, inout GpuNeuralRayState st) {
     st.status = NB_NRAY_TRACE;
 }
 
-void nb_nl_begin(GpuNeuralRayState st, uint root, uint want) {
-    g_nl_root = root;
+void nb_nl_begin(GpuNeuralRayState st, uint lod, uint want) {
+    g_nl_lod = min(lod, NB_NEURAL_MAX_LODS - 1u);
     g_nl_last_t = st.key_t;
     g_nl_last_inst = st.key_instance;
     g_nl_last_leaf = st.key_leaf;

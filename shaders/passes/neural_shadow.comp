@@ -44,7 +44,7 @@ void main() {
     float tmax = uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, i));
     uint pixel = shadow_load1(NB_SHADOW_PIXEL, i);
     g_alpha_seed = nb_pcg_hash(pixel ^ (pc.depth << 24u) ^ pc.sample_index);
-    nb_nl_begin(st, neural_params.root_secondary, nb_nl_want(st));
+    nb_nl_begin(st, neural_params.lod_secondary, nb_nl_want(st));
     g_nl_skip_triangles = op != 0u;
     nb_trace(org, dir, 0.0f, tmax, true);
     if (op == 0u && g_hit_instance != NB_NO_HIT) {

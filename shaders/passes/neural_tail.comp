@@ -35,7 +35,7 @@ void main() {
     float tmax = shadow ? uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, i)) : NB_INF;
     g_alpha_seed = shadow ? nb_pcg_hash(shadow_load1(NB_SHADOW_PIXEL, i) ^ (pc.depth << 24u) ^ pc.sample_index)
                           : ray_load1(pc.in_queue, NB_RAY_RNG, i);
-    uint root = (shadow || pc.depth != 0u) ? neural_params.root_secondary : neural_params.root_primary;
+    uint lod = (shadow || pc.depth != 0u) ? neural_params.lod_secondary : neural_params.lod_primary;
     GpuNeuralRayState st = neural_state[ray];
     bool last = st.status == NB_NRAY_PENDING_LAST; // no leaf left behind this group
     // The group queued by the last batched round, in key order.
@@ -55,7 +55,7 @@ void main() {
         float limit = shadow ? tmax : min(st.tri_t, st.best_t);
         bool found = false;
         if (!last) { // (only the first iteration can see last == true: it returns below)
-            nb_nl_begin(st, root, 1u);
+            nb_nl_begin(st, lod, 1u);
             g_nl_skip_triangles = true;
             nb_trace(org, dir, tmin, limit, shadow);
             found = g_nl_cand_n > 0u && g_nl_cand_t[0] < limit && st.rounds < neural_params.max_rounds;

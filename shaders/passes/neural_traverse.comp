@@ -56,7 +56,7 @@ void main() {
     vec3 dir = ray_load3(q, NB_RAY_DIR, i);
     g_alpha_seed = ray_load1(q, NB_RAY_RNG, i);
     float t_resume = uintBitsToFloat(ray_load1(q, NB_RAY_T_RESUME, i));
-    nb_nl_begin(st, pc.depth == 0u ? neural_params.root_primary : neural_params.root_secondary, nb_nl_want(st));
+    nb_nl_begin(st, pc.depth == 0u ? neural_params.lod_primary : neural_params.lod_secondary, nb_nl_want(st));
     if (op == 0u) {
         g_nl_skip_triangles = false;
         nb_trace(org, dir, t_resume, NB_INF, false);

@@ -107,13 +107,24 @@ struct GpuNeuralRayState {
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralRayState) == 64, "GpuNeuralRayState layout");
 
+// One neural asset of the model (engine/neural/model_file.h ModelAsset), indexed by a neural
+// GpuInstance's blas_root: where its N-BVH subtree starts in each LoD's GPU node array, and the scene
+// material its hits are shaded with (the albedo is the network's).
+#define NB_NEURAL_MAX_LODS 8u
+struct GpuNeuralAsset {
+    uint roots[NB_NEURAL_MAX_LODS]; // GPU node of its cut per LoD (LoDs past the model's: the coarsest)
+    uint material;                  // index into the scene materials
+    uint pad0, pad1, pad2;
+};
+NB_STATIC_ASSERT(sizeof(GpuNeuralAsset) == 48, "GpuNeuralAsset layout");
+
 // Neural constants of a render (storage buffer, one struct).
 struct GpuNeuralParams {
     GpuEncodingBox box;
-    uint root_primary;    // first GPU node of the N-BVH cut used by camera rays (--lod)
-    uint root_secondary;  // ... by rays after the first hit (--secondary-lod)
-    float roughness;      // material constants of neural surfaces (--neural-roughness/--neural-metallic)
-    float metallic;
+    uint lod_primary;     // N-BVH cut used by camera rays (--lod)
+    uint lod_secondary;   // ... by rays after the first hit (--secondary-lod)
+    float roughness;      // < 0: the asset's material; else an explicit override (--neural-roughness)
+    float metallic;       // < 0: the asset's material; else --neural-metallic
     float threshold;      // visibility threshold
     uint max_rounds;      // leaves queried per ray at most (then the best hit so far is kept)
     uint leaves_per_round; // 1..NB_NL_MAX_LEAVES_PER_ROUND leaves queued per ray per traversal round
@@ -139,6 +150,7 @@ NB_STATIC_ASSERT(sizeof(GpuNeuralCounters) == 16, "GpuNeuralCounters layout");
 #define NB_BIND_NEURAL_PARAMS 26u
 #define NB_BIND_NEURAL_COUNTERS 27u
 #define NB_BIND_NEURAL_MLP_T 28u    // the weights with each matrix transposed (cooperative-matrix pass)
-#define NB_NEURAL_BINDING_END 29u
+#define NB_BIND_NEURAL_ASSETS 29u   // GpuNeuralAsset[]
+#define NB_NEURAL_BINDING_END 30u
 
 #endif

@@ -43,7 +43,8 @@
     S(GpuNeuralEvalPush, 17) \
     S(GpuNeuralRayState, 18) \
     S(GpuNeuralParams, 19)   \
-    S(GpuNeuralCounters, 20)
+    S(GpuNeuralCounters, 20) \
+    S(GpuNeuralAsset, 21)
 
 // --- field lists ---------------------------------------------------------------------------------
 #define NB_LAYOUT_FIELDS_GpuBvhNode(F) \
@@ -91,9 +92,12 @@
     F(normal) F(best_t) F(albedo) F(instance) F(key_t) F(key_instance) F(key_leaf) F(status)      \
     F(tri_t) F(tri_instance) F(tri_triangle) F(rounds)
 #define NB_LAYOUT_FIELDS_GpuNeuralParams(F)                                                       \
-    F(box.center) F(box.depth_pad) F(box.extent) F(box.fixed_depth_eps) F(root_primary)           \
-    F(root_secondary) F(roughness) F(metallic) F(threshold) F(max_rounds) F(leaves_per_round) F(pad1)
+    F(box.center) F(box.depth_pad) F(box.extent) F(box.fixed_depth_eps) F(lod_primary)            \
+    F(lod_secondary) F(roughness) F(metallic) F(threshold) F(max_rounds) F(leaves_per_round) F(pad1)
 #define NB_LAYOUT_FIELDS_GpuNeuralCounters(F) F(pending_active) F(queries_total) F(shadow_queries) F(rounds)
+#define NB_LAYOUT_FIELDS_GpuNeuralAsset(F)                                                        \
+    F(roots[0]) F(roots[1]) F(roots[2]) F(roots[3]) F(roots[4]) F(roots[5]) F(roots[6]) F(roots[7]) \
+    F(material) F(pad0) F(pad1) F(pad2)
 
 // --- distinct, exactly representable, non-zero values ------------------------------------------
 // Field number k gets base value 16k (+1 for each further component), so every 4-byte word of a

@@ -27,6 +27,15 @@ void expect_rejected(const std::vector<uint8_t>& bytes, const std::string& needl
     }
 }
 
+template <class F> void expect_throw_containing(F&& f, const std::string& needle) {
+    try {
+        f();
+        ADD_FAILURE() << "no error (expected: " << needle << ")";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+}
+
 template <class T> void poke(std::vector<uint8_t>& b, size_t at, T v) { std::memcpy(b.data() + at, &v, sizeof(T)); }
 
 size_t section_offset(const std::vector<uint8_t>& b, const std::string& id) {
@@ -47,7 +56,8 @@ TEST(ModelFile, RoundTrip) {
         EXPECT_EQ(b.levels[i].scale, a.levels[i].scale);
         EXPECT_EQ(b.levels[i].hashed, a.levels[i].hashed);
     }
-    EXPECT_EQ(b.asset_name, "tiny_asset");
+    ASSERT_EQ(b.assets.size(), 1u);
+    EXPECT_EQ(b.assets[0].name, "tiny_asset");
     EXPECT_EQ(b.encoding_box.hi, glm::vec3(1.0f));
     EXPECT_EQ(b.lod_count, 2u);
     EXPECT_EQ(b.lod_node_counts, (std::vector<uint32_t>{5, 3}));
@@ -97,7 +107,7 @@ TEST(ModelFile, SaveIsAtomicAndLoadReadsItBack) {
 // Pins the format: any change to the byte layout must bump MODEL_FORMAT_VERSION and this test.
 TEST(ModelFile, GoldenBytes) {
     const std::vector<uint8_t> b = serialize_model(make_tiny_model());
-    const uint8_t head[16] = {'N', 'B', 'V', 'H', 1, 0, 0, 0, 8, 0, 0, 0, 0, 0, 0, 0};
+    const uint8_t head[16] = {'N', 'B', 'V', 'H', 2, 0, 0, 0, 8, 0, 0, 0, 0, 0, 0, 0};
     ASSERT_GE(b.size(), 16u);
     EXPECT_EQ(std::memcmp(b.data(), head, 16), 0);
     std::vector<std::string> ids;
@@ -111,8 +121,8 @@ TEST(ModelFile, GoldenBytes) {
     // at every LoD), flags 0, padding.
     const uint32_t node_head[2 + 10] = {5, 0, 0, 0, 0, 0x3f800000u, 0x3f800000u, 0x3f800000u, 1, 0, 0xFFu, 0};
     EXPECT_EQ(std::memcmp(b.data() + section_offset(b, "NODE"), node_head, sizeof(node_head)), 0);
-    EXPECT_EQ(b.size(), 40912u);
-    EXPECT_EQ(fnv1a64(b.data(), b.size()), 0x72109c6f7a43444cull) << std::hex << fnv1a64(b.data(), b.size());
+    EXPECT_EQ(b.size(), 40984u);
+    EXPECT_EQ(fnv1a64(b.data(), b.size()), 0x7c713906138de22bull) << std::hex << fnv1a64(b.data(), b.size());
 }
 
 TEST(ModelFile, TruncationAnywhereIsRejected) {
@@ -161,9 +171,9 @@ TEST(ModelFile, ForeignFilesAreRejected) {
     expect_rejected(c, "not an nbvh model (bad magic)");
     expect_rejected({}, "not an nbvh model (file too short)");
     c = b;
-    poke<uint32_t>(c, 4, 2);
+    poke<uint32_t>(c, 4, 3);
     refresh_checksums(c);
-    expect_rejected(c, "unsupported model format version 2");
+    expect_rejected(c, "unsupported model format version 3");
     // An official N-BVH tree file (u64 N, u64 1, N x 40 bytes, u64 0) of 3 nodes.
     std::vector<uint8_t> official(16 + 3 * 40 + 8, 0);
     poke<uint64_t>(official, 0, 3);
@@ -182,7 +192,9 @@ TEST(ModelFile, HostileCountsAreRejectedBeforeAllocation) {
     expect_rejected(edited("NODE", 0, uint32_t(0xFFFFFFFF)), "node count 4294967295 exceeds the section size");
     expect_rejected(edited("GRID", 0, uint64_t(1) << 62), "values, the level table needs");
     expect_rejected(edited("MLP ", 0, uint32_t(0x7FFFFFFF)), "weights, expected");
-    expect_rejected(edited("ASST", 24, uint32_t(0xFFFFFFF0)), "asset name length");
+    expect_rejected(edited("ASST", 24, uint32_t(0xFFFFFFF0)), "asset count 4294967280 out of range");
+    expect_rejected(edited("ASST", 32, uint32_t(0xFFFFFFF0)), "asset name length");
+    expect_rejected(edited("ASST", 64, uint32_t(0xFFFFFFF0)), "node path count 4294967280 exceeds the section");
     expect_rejected(edited("LODS", 0, uint32_t(1000000)), "node counts for 2 LoDs");
     expect_rejected(edited("CONF", 36, uint32_t(200)), "LoD count 200 out of range");
     std::vector<uint8_t> c = b;
@@ -217,7 +229,11 @@ TEST(ModelFile, BadContentIsRejected) {
     expect_rejected(edited("GRID", 8, uint16_t(0xFC00)), "grid value 0 is not finite");
     expect_rejected(edited("ASST", 0, std::numeric_limits<float>::infinity()), "encoding box is not finite");
     expect_rejected(edited("ASST", 12, 0.0f), "encoding box has no volume");
-    expect_rejected(edited("ASST", 28, uint8_t(27)), "control character"); // ESC in the name
+    expect_rejected(edited("ASST", 36, uint8_t(27)), "control character"); // ESC in the name
+    // The asset table: root (u32 at 84) a node, placement (scale f32 at 92) finite and positive.
+    expect_rejected(edited("ASST", 84, uint32_t(99)), "asset 'tiny_asset' root 99 is not a node");
+    expect_rejected(edited("ASST", 92, -1.0f), "non-finite or non-positive placement");
+    expect_rejected(edited("ASST", 96, std::numeric_limits<float>::quiet_NaN()), "non-finite or non-positive placement");
     expect_rejected(edited("META", 8, -1.0), "non-finite or negative");
     expect_rejected(edited("META", 76, uint32_t(0xFFFF)), "backend length");
     expect_rejected(edited("CONF", 24, uint32_t(32)), "unsupported mlp_width 32");
@@ -245,6 +261,36 @@ TEST(ModelFile, ChessReferenceIsTheOfficialFormat) {
     EXPECT_EQ(finals, 106u);
     EXPECT_EQ(min_leaf_depth, 10u);
     EXPECT_EQ(tree.max_depth(), 21u);
+}
+
+// Several assets: their subtrees must be disjoint (a root inside another asset's subtree, or shared, is
+// refused when saving as when loading), names unique; a valid table round-trips.
+TEST(ModelFile, AssetTable) {
+    NeuralModel m = make_tiny_model();
+    ModelAsset second = m.assets[0];
+    second.name = "second";
+    second.root = 1;
+    m.assets.push_back(second);
+    expect_throw_containing([&] { serialize_model(m); }, "asset 'second' lies inside asset 'tiny_asset'");
+    m.assets[1].root = 0;
+    expect_throw_containing([&] { serialize_model(m); }, "share a root");
+    // Root 0's children (1, 2) as two assets: disjoint.
+    m.assets[0].root = 1;
+    m.assets[1].root = 2;
+    m.assets[1].node_paths = {"a", "b"};
+    m.assets[1].geometry_hash = 0x1234;
+    m.assets[1].scale = 0.5f;
+    m.assets[1].offset = glm::vec3(1.0f, 2.0f, 3.0f);
+    const NeuralModel r = parse_model(serialize_model(m));
+    ASSERT_EQ(r.assets.size(), 2u);
+    EXPECT_EQ(r.assets[1].name, "second");
+    EXPECT_EQ(r.assets[1].root, 2u);
+    EXPECT_EQ(r.assets[1].node_paths, (std::vector<std::string>{"a", "b"}));
+    EXPECT_EQ(r.assets[1].geometry_hash, 0x1234u);
+    EXPECT_EQ(r.assets[1].scale, 0.5f);
+    EXPECT_EQ(r.assets[1].offset, glm::vec3(1.0f, 2.0f, 3.0f));
+    m.assets[1].name = "tiny_asset";
+    expect_throw_containing([&] { serialize_model(m); }, "appears twice");
 }
 
 } // namespace

@@ -21,7 +21,8 @@ inline NeuralModel make_tiny_model() {
     NeuralModel m;
     m.cfg.log2_hash_size = 4;
     m.levels = neural::make_level_table(m.cfg);
-    m.asset_name = "tiny_asset";
+    m.assets.resize(1);
+    m.assets[0].name = m.assets[0].mesh = "tiny_asset";
     m.encoding_box.lo = glm::vec3(0.0f);
     m.encoding_box.hi = glm::vec3(1.0f);
     static const Bvh base = make_complete_bvh(3);

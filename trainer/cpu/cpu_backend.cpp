@@ -19,16 +19,20 @@ namespace nbvh {
 TrainingSample draw_training_sample(const TrainingAsset& asset, std::span<const TrainingCut* const> cuts, Pcg32& rng,
                                     uint32_t* leaf_draws, uint64_t& draws, uint32_t max_draws) {
     TrainingSample s;
-    const glm::vec3 lo = asset.sampling_box.lo, ext = asset.sampling_box.extent();
     for (uint32_t attempt = 0; attempt < max_draws; ++attempt) {
         draws++;
         const uint32_t c = cuts.size() > 1 ? std::min(uint32_t(rng.next_float() * float(cuts.size())),
                                                      uint32_t(cuts.size() - 1))
                                            : 0u;
+        // The part (one draw only with several, so one-asset ray sets are unchanged), then the origin
+        // in its sampling box; the cut search stays inside its subtree.
+        const TrainingPart& part = asset.parts[asset.parts.size() > 1 ? pick_part(asset, rng.next_float()) : 0u];
+        const glm::vec3 lo = part.sampling_box.lo, ext = part.sampling_box.extent();
         const glm::vec3 o = lo + ext * glm::vec3(rng.next_float(), rng.next_float(), rng.next_float());
         const glm::vec3 d = uniform_sphere_direction(rng.next_float(), rng.next_float());
         const float dilation = 1e-5f + 1e-4f * rng.next_float(); // notes §1, training dilation
-        const FirstLeaf f = first_leaf_of_cut(asset.bvh(), asset.node_boxes, *cuts[c], o, d, dilation, asset.min_exit);
+        const FirstLeaf f = first_leaf_of_cut(asset.bvh(), asset.node_boxes, *cuts[c], o, d, dilation, asset.min_exit,
+                                              part.root);
         if (f.leaf < 0) continue; // the ray meets no leaf: redraw
         if (c == 0) {
             if (leaf_draws) leaf_draws[f.leaf]++;

@@ -74,10 +74,11 @@ cuda::CoreAsset flatten_asset(const TrainingAsset& asset) {
         for (int q = 0; q < 3; ++q) a.tri_geo_normal[size_t(k) * 3 + q] = g[q];
     }
     a.encoding = asset.encoding;
-    const glm::vec3 lo = asset.sampling_box.lo, ext = asset.sampling_box.extent();
-    for (int k = 0; k < 3; ++k) {
-        a.sampling_lo[k] = lo[k];
-        a.sampling_ext[k] = ext[k];
+    for (const TrainingPart& p : asset.parts) {
+        const glm::vec3 lo = p.sampling_box.lo, ext = p.sampling_box.extent();
+        for (int k = 0; k < 3; ++k) a.part_boxes.push_back(lo[k]);
+        for (int k = 0; k < 3; ++k) a.part_boxes.push_back(ext[k]);
+        a.part_roots.push_back(p.root);
     }
     a.min_exit = asset.min_exit;
     return a;

@@ -139,7 +139,12 @@ public:
         da_.mesh_nodes = a.mesh_nodes.empty() ? nullptr : mesh_nodes_.p;
         da_.tri_v = tri_v_.p; da_.tri_n = tri_n_.p; da_.tri_a = tri_a_.p; da_.tri_g = tri_g_.p;
         da_.enc = a.encoding;
-        for (int k = 0; k < 3; ++k) { da_.s_lo[k] = a.sampling_lo[k]; da_.s_ext[k] = a.sampling_ext[k]; }
+        NBVH_CHECK_SIZE(!a.part_roots.empty() && a.part_boxes.size() == 6 * a.part_roots.size());
+        part_boxes_.upload(a.part_boxes);
+        part_roots_.upload(a.part_roots);
+        da_.part_boxes = part_boxes_.p;
+        da_.part_roots = part_roots_.p;
+        da_.parts = uint32_t(a.part_roots.size());
         da_.min_exit = a.min_exit;
 
         NBVH_CHECK_SIZE(c.levels.size() == NB_GRID_MAX_LEVELS && c.mlp.size() == NB_MLP_WEIGHT_COUNT);
@@ -359,7 +364,8 @@ private:
     DevNetwork net_{};
     DevBatch batch_{};
     uint32_t grid_n_ = 0, leaves_ = 0;
-    DevBuf<float> node_boxes_, tri_v_, tri_n_, tri_a_, tri_g_;
+    DevBuf<float> node_boxes_, tri_v_, tri_n_, tri_a_, tri_g_, part_boxes_;
+    DevBuf<uint32_t> part_roots_;
     DevBuf<uint2> children_;
     DevBuf<GpuBvhNode> mesh_nodes_;
     DevBuf<float> grid_w_, grid_m_, grid_v_, grid_grad_, mlp_w_, mlp_m_, mlp_v_, mlp_grad_, slices_, keep_;

@@ -26,7 +26,10 @@ struct CoreAsset {
     std::vector<float> tri_albedo;      // 9 per triangle: per-vertex albedo (factor x texture at the vertex uv)
     std::vector<float> tri_geo_normal;  // 3 per triangle: unit geometric normal (fallback)
     GpuEncodingBox encoding;
-    float sampling_lo[3], sampling_ext[3];
+    // Parts of a multi-asset run (trainer/training_asset.h TrainingPart): sampling box (lo xyz, extent
+    // xyz) and base-BVH root per part; at least one.
+    std::vector<float> part_boxes;
+    std::vector<uint32_t> part_roots;
     float min_exit = 0.0f;
 };
 

@@ -52,7 +52,9 @@ struct DevAsset {
     const float* tri_a = nullptr;        // 9 per triangle
     const float* tri_g = nullptr;        // 3 per triangle
     GpuEncodingBox enc;
-    float s_lo[3], s_ext[3];
+    const float* part_boxes = nullptr;    // 6 per part: sampling box lo xyz, extent xyz
+    const uint32_t* part_roots = nullptr; // base-BVH root per part
+    uint32_t parts = 1;
     float min_exit = 0.0f;
 };
 

@@ -38,7 +38,7 @@ __device__ bool clip_dilated(const float* box, vec3 o, vec3 d, float dilation, f
 struct Found { int32_t leaf; float t_entry, t_exit; };
 
 // first_leaf_of_cut: nearest-first descent of the base BVH, stopping at cut leaves.
-__device__ Found first_leaf(const DevAsset& a, const int32_t* leaf_of, vec3 o, vec3 d, float dilation) {
+__device__ Found first_leaf(const DevAsset& a, const int32_t* leaf_of, vec3 o, vec3 d, float dilation, uint32_t root) {
     Found best{-1, 0.0f, 0.0f};
     float best_entry = NB_INF;
     uint32_t st_node[NB_BVH_MAX_DEPTH * 2 + 2];
@@ -46,8 +46,8 @@ __device__ Found first_leaf(const DevAsset& a, const int32_t* leaf_of, vec3 o, v
     int top = 0;
     float t0, t1;
     if (a.base_nodes == 0) return best;
-    if (!clip_dilated(a.node_boxes, o, d, dilation, t0, t1) || t1 <= a.min_exit) return best;
-    st_node[top] = 0u;
+    if (!clip_dilated(a.node_boxes + size_t(root) * 6, o, d, dilation, t0, t1) || t1 <= a.min_exit) return best;
+    st_node[top] = root;
     st_t[top++] = t0;
     while (top > 0) {
         --top;
@@ -104,17 +104,20 @@ __global__ void k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint
     for (uint32_t attempt = 0; attempt < max_draws; ++attempt) {
         draws++;
         const uint32_t ci = c.count > 1 ? min(uint32_t(rng.next_float() * float(c.count)), c.count - 1u) : 0u;
+        // The part (trainer/training_asset.h pick_part; drawn only when there are several).
+        const uint32_t pi = a.parts > 1 ? min(uint32_t(rng.next_float() * float(a.parts)), a.parts - 1u) : 0u;
+        const float* pb = a.part_boxes + size_t(pi) * 6;
         // The CPU evaluates glm::vec3(f(), f(), f()) and uniform_sphere_direction(f(), f()) arguments
         // right to left (g++): z first, then y, then x; u2 before u1.
         const float rz = rng.next_float(), ry = rng.next_float(), rx = rng.next_float();
-        const vec3 o(a.s_lo[0] + a.s_ext[0] * rx, a.s_lo[1] + a.s_ext[1] * ry, a.s_lo[2] + a.s_ext[2] * rz);
+        const vec3 o(pb[0] + pb[3] * rx, pb[1] + pb[4] * ry, pb[2] + pb[5] * rz);
         const float u2 = rng.next_float(), u1 = rng.next_float();
         const float phi = 2.0f * 3.14159265358979323846f * u1;
         const float cos_theta = 2.0f * u2 - 1.0f;
         const float sin_theta = sqrtf(fmaxf(0.0f, 1.0f - cos_theta * cos_theta));
         const vec3 d(sin_theta * cosf(phi), sin_theta * sinf(phi), cos_theta);
         const float dilation = 1e-5f + 1e-4f * rng.next_float();
-        const Found f = first_leaf(a, c.leaf_of[ci], o, d, dilation);
+        const Found f = first_leaf(a, c.leaf_of[ci], o, d, dilation, a.part_roots[pi]);
         if (f.leaf < 0) continue;
         if (ci == 0) {
             atomicAdd(&c.leaf_draws[f.leaf], 1u);

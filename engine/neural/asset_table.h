@@ -1,0 +1,39 @@
+// The scene side of a model's asset table (ARCHITECTURE.md "Which assets are neural"): a neural asset
+// is a unique (mesh, material) of the scene; instances share it. Training and rendering both cut the
+// neural meshes of several materials into one mesh per material first (split_neural_meshes), so an
+// asset is exactly one scene mesh; fingerprints tie a model to the geometry and material it learned.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "engine/neural/model_file.h"
+#include "engine/scene/scene.h"
+
+namespace nbvh {
+
+// Cuts every mesh used by a neural instance whose triangles use several materials into one mesh per
+// material (named "MESH/MATERIAL", Mesh::split_from = MESH) and replaces each neural instance of it by
+// one instance per part (same node name and transform). Classical instances keep the original mesh.
+// Returns how many meshes were cut.
+uint32_t split_neural_meshes(Scene& scene);
+
+// FNV-1a 64 of the positions and indices (what the N-BVH learned).
+uint64_t geometry_fingerprint(const Mesh& mesh);
+// FNV-1a 64 of what the learned albedo depends on: base colour factor and texture (texels, uv set,
+// transform) and the alpha mode. 0 for an out-of-range material.
+uint64_t material_fingerprint(const Scene& scene, uint32_t material);
+
+// The table entry of scene mesh `mesh` (one material after split_neural_meshes): names, node paths of
+// its neural instances, fingerprints. Root, triangles and placement are the trainer's.
+ModelAsset describe_asset(const Scene& scene, uint32_t mesh);
+
+// Binds a model to a scene: the model's assets decide which instances are neural (every instance of a
+// glTF mesh the model has an asset for), meshes are split by material, and every neural mesh must
+// match its asset (name, geometry and material fingerprints). Returns, per scene mesh (after the
+// split), the index of its asset or -1. Throws nbvh::Error with one line naming the first asset that
+// does not match (or is missing), prefixed by `model_name`.
+std::vector<int32_t> bind_model_to_scene(Scene& scene, const NeuralModel& model, const std::string& model_name);
+
+} // namespace nbvh
