@@ -15,8 +15,8 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
     cmd->add_option("--max-depth", o.max_depth, "maximum path segments (1 = direct visibility)")
         ->check(CLI::Range(1u, 256u));
     cmd->add_option("--seed", o.seed, "random seed");
-    cmd->add_option("--neural-roughness", o.neural.roughness, "roughness of neural surfaces [0,1]");
-    cmd->add_option("--neural-metallic", o.neural.metallic, "metallic of neural surfaces [0,1]");
+    cmd->add_option("--neural-roughness", o.neural.roughness, "override the roughness of neural surfaces [0,1] (default: each asset's glTF material)");
+    cmd->add_option("--neural-metallic", o.neural.metallic, "override the metallic of neural surfaces [0,1] (default: each asset's glTF material)");
     cmd->add_option("--neural-max-leaves", o.neural.max_rounds,
                     "neural leaves queried per ray at most (then the closest hit so far is kept)");
     cmd->add_option("--neural-batched-rounds", o.neural.batched_rounds,

@@ -110,7 +110,6 @@ TrainingAsset make_training_asset(const Scene& scene, std::span<const uint32_t> 
         }
         std::vector<Bvh> part_bvhs;
         std::vector<uint32_t> prim_offsets;
-        a.mesh_bvh.vertices.clear();
         for (uint32_t i = 0; i < n; ++i) {
             const Mesh& mesh = scene.meshes[meshes[i]];
             TrainingPart p;
@@ -139,7 +138,6 @@ TrainingAsset make_training_asset(const Scene& scene, std::span<const uint32_t> 
             for (uint32_t idx : placed.indices) combined->indices.push_back(idx + vbase);
             for (uint32_t t = 0; t < placed.triangle_count(); ++t)
                 combined->triangle_material.push_back(t < placed.triangle_material.size() ? placed.triangle_material[t] : 0u);
-            a.mesh_bvh.vertices.insert(a.mesh_bvh.vertices.end(), mb.vertices.begin(), mb.vertices.end());
             prim_offsets.push_back(p.first_triangle);
             part_bvhs.push_back(std::move(mb.bvh));
             a.parts.push_back(p);
@@ -150,6 +148,9 @@ TrainingAsset make_training_asset(const Scene& scene, std::span<const uint32_t> 
         for (Bvh& b : part_bvhs) pad_node_bounds(b, a.min_extent);
         std::vector<uint32_t> roots;
         a.mesh_bvh.bvh = join_bvhs(part_bvhs, prim_offsets, &roots);
+        // Triangle vertices in the joined leaf order (the parts' ranges follow the top tree's order).
+        for (uint32_t t : a.mesh_bvh.bvh.prim_indices)
+            for (int k = 0; k < 3; ++k) a.mesh_bvh.vertices.push_back(combined->positions[combined->indices[3 * t + k]]);
         for (uint32_t i = 0; i < n; ++i) a.parts[i].root = roots[i];
         a.owned_mesh = combined;
         a.mesh = combined.get();

@@ -223,3 +223,65 @@ TEST(Trainer, GrowsTheCutToTheTargetAndWritesTheLog) {
     EXPECT_EQ(back.meta.backend, "cpu");
     EXPECT_EQ(back.encoding_box.lo, asset.bounds.lo);
 }
+
+// Several assets (training_asset.h): each part is one subtree of the joined base BVH, its triangles in
+// its own atlas cell, the leaf-order vertices match the primitive order (the joined tree orders the
+// parts by its top tree, not by part index), and the first-leaf search from a part's root stays in it.
+TEST(TrainingAsset, PartsAreDisjointSubtreesOfTheJoinedBvh) {
+    Scene s = test::scene_of(test::cube(1.0f));
+    for (int k = 1; k < 6; ++k) {
+        Mesh m = test::cube(0.3f + 0.2f * float(k), glm::vec3(float(k), 0.5f * float(k), 0.0f));
+        m.name = "box" + std::to_string(k);
+        m.triangle_material.assign(m.triangle_count(), 0u);
+        s.meshes.push_back(std::move(m));
+        Instance i;
+        i.mesh = uint32_t(k);
+        i.neural = true;
+        s.instances.push_back(i);
+    }
+    const std::vector<uint32_t> meshes = neural_meshes(s);
+    ASSERT_EQ(meshes.size(), 6u);
+    const TrainingAsset a = make_training_asset(s, meshes);
+    ASSERT_EQ(a.parts.size(), 6u);
+    const Bvh& bvh = a.bvh();
+    for (size_t k = 0; k < bvh.prim_indices.size(); ++k)
+        for (int c = 0; c < 3; ++c)
+            ASSERT_EQ(a.mesh_bvh.vertices[3 * k + c], a.mesh->positions[a.mesh->indices[3 * bvh.prim_indices[k] + c]]);
+    for (size_t p = 0; p < a.parts.size(); ++p) {
+        const TrainingPart& part = a.parts[p];
+        EXPECT_NEAR(std::max({part.bounds.extent().x, part.bounds.extent().y, part.bounds.extent().z}), 1.0f, 1e-3f);
+        EXPECT_EQ(a.above_parts[part.root], 0);
+        // Every leaf under the root holds only this part's triangles.
+        std::vector<uint32_t> stack{part.root};
+        uint32_t tris = 0;
+        while (!stack.empty()) {
+            const BvhNode& n = bvh.nodes[stack.back()];
+            stack.pop_back();
+            if (!n.is_leaf()) {
+                stack.push_back(n.left);
+                stack.push_back(n.right);
+                continue;
+            }
+            for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+                const uint32_t t = bvh.prim_indices[i];
+                EXPECT_GE(t, part.first_triangle);
+                EXPECT_LT(t, part.first_triangle + part.triangle_count);
+                ++tris;
+            }
+        }
+        EXPECT_EQ(tris, part.triangle_count);
+        // Rays from the part's sampling box find leaves of its subtree only, and their ground truth hits it.
+        TrainingCut cut;
+        std::vector<uint32_t> leaves;
+        for (uint32_t i = 0; i < bvh.nodes.size(); ++i)
+            if (bvh.nodes[i].is_leaf()) leaves.push_back(i);
+        cut.assign(leaves, bvh.nodes.size());
+        const glm::vec3 c = part.bounds.center();
+        const FirstLeaf f = first_leaf_of_cut(bvh, a.node_boxes, cut, c + glm::vec3(0, 0, 2), glm::vec3(0, 0, -1), 1e-5f,
+                                              a.min_exit, part.root);
+        ASSERT_GE(f.leaf, 0);
+        const BvhNode& leaf = bvh.nodes[cut.leaves[size_t(f.leaf)]];
+        EXPECT_GE(bvh.prim_indices[leaf.first], part.first_triangle);
+        EXPECT_LT(bvh.prim_indices[leaf.first], part.first_triangle + part.triangle_count);
+    }
+}
