@@ -37,6 +37,22 @@ bool is_neural_scene_name(const std::string& name) {
     return name.size() >= suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
+// tinygltf's default file callbacks open whatever a buffer or image URI names: a directory opens and reports
+// a bogus size (std::bad_alloc on ext4, fuzz regression seed crash_buffer_uri_is_directory.gltf) and a FIFO
+// blocks. Only regular files are files here.
+bool regular_file(const std::string& path) {
+    std::error_code ec;
+    return std::filesystem::is_regular_file(path, ec);
+}
+bool file_exists(const std::string& path, void*) { return regular_file(path); }
+bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+    if (!regular_file(path)) {
+        if (err) *err += "not a regular file: " + path + "\n";
+        return false;
+    }
+    return tinygltf::ReadWholeFile(out, err, path, user);
+}
+
 tinygltf::Model parse_file(const std::filesystem::path& path, bool keep_textures) {
     const std::string file = path.string();
     // A directory opens as an ifstream on Linux and tinygltf then sizes its read buffer from it (a huge
@@ -77,6 +93,7 @@ tinygltf::Model parse_file(const std::filesystem::path& path, bool keep_textures
     in.close();
 
     tinygltf::TinyGLTF loader;
+    loader.SetFsCallbacks({&file_exists, &tinygltf::ExpandFilePath, &read_whole_file, &tinygltf::WriteWholeFile, nullptr});
     gltf::ImageDecodeContext images{keep_textures, 0};
     loader.SetImageLoader(gltf::decode_image, &images);
     tinygltf::Model model;
