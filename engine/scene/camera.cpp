@@ -1,5 +1,6 @@
 #include "engine/scene/camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -35,7 +36,11 @@ Camera auto_frame(const Scene& scene, float aspect) {
     const glm::vec3 centre = b.center();
     float radius = 0.5f * glm::length(b.extent());
     if (!std::isfinite(radius) || !std::isfinite(centre.x + centre.y + centre.z)) return cam;
-    radius = std::max(radius, 1e-3f);
+    // No absolute floor (a 0.1 mm asset must be framed like a 10 km one): only enough float spacing
+    // around the centre for eye != target (a point-like scene far from the origin), and a tiny absolute
+    // value for a point at the origin. 1e-5 |centre| is ~80 float ulps of the centre's coordinates.
+    const float max_abs = std::max({std::fabs(centre.x), std::fabs(centre.y), std::fabs(centre.z)});
+    radius = std::max({radius, 1e-5f * max_abs, 1e-20f});
     cam.yfov = 0.6f; // ~34 degrees
     const float safe_aspect = (aspect > 0.0f && std::isfinite(aspect)) ? aspect : 1.0f;
     const float half_x = std::atan(std::tan(0.5f * cam.yfov) * safe_aspect);

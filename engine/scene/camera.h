@@ -19,8 +19,9 @@ CameraBasis look_at(const glm::vec3& eye, const glm::vec3& target, const glm::ve
 CameraBasis camera_basis(const Camera& camera);
 
 // A camera that shows the whole scene (world bounds) from the front-right, slightly above, with the
-// bounding sphere filling the smaller of the two fovs. Empty scene: the default camera. Flat or huge
-// scenes stay finite (distance from the bounding-sphere radius, at least 1e-3).
+// bounding sphere filling the smaller of the two fovs. Empty scene: the default camera. Scale-free: the
+// eye-target distance is a fixed multiple of the bounding-sphere radius at any size (0.1 mm .. 10 km) and
+// distance from the origin; point-like scenes stay finite with eye != target.
 Camera auto_frame(const Scene& scene, float aspect);
 
 // "ex,ey,ez,tx,ty,tz,fov_deg" (fov vertical, degrees in (0, 180)); throws nbvh::Error naming the problem
