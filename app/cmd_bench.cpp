@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,7 @@ namespace {
 
 struct BenchArgs {
     std::string scene, model, device = "auto", json, neural_path = "auto", camera, env;
+    std::optional<float> env_rotation; // degrees
     uint32_t repeat = 3;
     render::RenderOptions options;
     BenchArgs() {
@@ -92,7 +94,8 @@ void run_bench(const BenchArgs& a) {
     if (a.repeat == 0) throw Error("--repeat must be at least 1");
     const NeuralModel model = load_model(a.model);
     const Scene scene = load_scene_for_model(a.scene, {}, &model, a.model);
-    const Environment env = choose_environment(scene, a.env);
+    Environment env = choose_environment(scene, a.env);
+    if (a.env_rotation) env.rotation = *a.env_rotation * 3.14159265358979f / 180.0f;
     const Camera camera = choose_camera(scene, a.camera, options);
     vk::Context ctx(copt);
     const SceneAccel accel = build_scene_accel(scene);
@@ -169,6 +172,8 @@ void add_bench_command(CLI::App& app) {
     cmd->add_option("--neural-path", args->neural_path, "MLP implementation: auto, scalar or coopmat");
     cmd->add_option("--camera", args->camera, "eye_x,eye_y,eye_z,target_x,target_y,target_z,fov_deg");
     cmd->add_option("--env", args->env, "environment map (.hdr or .exr, equirectangular)");
+    cmd->add_option("--env-rotation", args->env_rotation, "rotate the environment about +y by this many degrees")
+        ->check(CLI::Range(-3600.0f, 3600.0f));
     cmd->callback([args] { run_bench(*args); });
 }
 

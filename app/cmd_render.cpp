@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,7 @@ namespace {
 
 struct RenderArgs {
     std::string scene, out = "render.png", device = "auto", camera, env, stats;
+    std::optional<float> env_rotation; // degrees
     std::string model, neural_path = "auto", neural_glob;
     render::RenderOptions options;
     bool explain = false;
@@ -90,7 +92,8 @@ void run_render(const RenderArgs& a) {
     Scene scene = load_scene_for_model(a.scene, lo, a.model.empty() ? nullptr : &model, a.model);
     if (!a.model.empty() && !options.neural.classical) options.neural.model = &model;
     options.neural.path = render::parse_neural_path(a.neural_path);
-    const Environment env = choose_environment(scene, a.env);
+    Environment env = choose_environment(scene, a.env);
+    if (a.env_rotation) env.rotation = *a.env_rotation * 3.14159265358979f / 180.0f;
     const Camera camera = choose_camera(scene, a.camera, a.options);
     if (a.explain) {
         std::printf("%s", render::explain(render::derive_features(scene, env), a.options.max_depth).c_str());
@@ -133,6 +136,8 @@ void add_render_command(CLI::App& app) {
     cmd->add_option("--device", args->device, "Vulkan device: auto, gpu or cpu (lavapipe)");
     cmd->add_option("--camera", args->camera, "eye_x,eye_y,eye_z,target_x,target_y,target_z,fov_deg");
     cmd->add_option("--env", args->env, "environment map (.hdr or .exr, equirectangular)");
+    cmd->add_option("--env-rotation", args->env_rotation, "rotate the environment about +y by this many degrees")
+        ->check(CLI::Range(-3600.0f, 3600.0f));
     cmd->add_option("--stats", args->stats, "write per-pass GPU times, ray counts and checks as JSON");
     cmd->add_flag("--explain", args->explain, "print the scene's feature set and the passes, then exit");
     cmd->add_option("--model", args->model, "N-BVH model (.nbvh) for the scene's neural instances (hybrid render)");

@@ -5,7 +5,7 @@
 
 #include "engine/core/error.h"
 #include "shaders/shared/intersect.h"
-#include "trainer/texture_sampler.h"
+#include "engine/scene/texture_sampler.h"
 
 namespace nbvh {
 

@@ -5,6 +5,9 @@
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
+#include "engine/scene/texture_sampler.h"
+
+#include <cmath>
 
 namespace nbvh {
 
@@ -110,6 +113,42 @@ uint64_t material_fingerprint(const Scene& scene, uint32_t material) {
         h = fnv1a64(&t.transform, sizeof(t.transform), h);
     }
     return h == 0 ? 1 : h; // 0 means "unknown"
+}
+
+AssetShading asset_shading(const Scene& scene, uint32_t mesh) {
+    NBVH_CHECK(mesh < scene.meshes.size());
+    const Mesh& m = scene.meshes[mesh];
+    const uint32_t mat = m.triangle_material.empty() ? 0u : m.triangle_material[0];
+    AssetShading s;
+    if (mat >= scene.materials.size()) return s;
+    const Material& material = scene.materials[mat];
+    s.metallic = std::clamp(material.metallic, 0.0f, 1.0f);
+    s.roughness = std::clamp(material.roughness, 0.0f, 1.0f);
+    const TextureRef& ref = material.metallic_roughness_tex;
+    const std::vector<glm::vec2>& uvs = ref.uv_set == 1u ? m.uv1 : m.uv0;
+    if (ref.texture < 0 || size_t(ref.texture) >= scene.textures.size() || uvs.size() != m.positions.size()) return s;
+    double area_sum = 0.0, metal = 0.0, rough = 0.0;
+    static constexpr float POINTS[4][3] = {{1.f / 3, 1.f / 3, 1.f / 3}, {2.f / 3, 1.f / 6, 1.f / 6},
+                                           {1.f / 6, 2.f / 3, 1.f / 6}, {1.f / 6, 1.f / 6, 2.f / 3}};
+    for (uint32_t t = 0; t < m.triangle_count(); ++t) {
+        const uint32_t* idx = &m.indices[3 * size_t(t)];
+        if (idx[0] >= m.positions.size() || idx[1] >= m.positions.size() || idx[2] >= m.positions.size()) continue;
+        const glm::vec3 p0 = m.positions[idx[0]], p1 = m.positions[idx[1]], p2 = m.positions[idx[2]];
+        const double area = 0.5 * double(glm::length(glm::cross(p1 - p0, p2 - p0)));
+        if (!(area > 0.0) || !std::isfinite(area)) continue;
+        for (const auto& w : POINTS) {
+            const glm::vec2 uv = w[0] * uvs[idx[0]] + w[1] * uvs[idx[1]] + w[2] * uvs[idx[2]];
+            const glm::vec4 c = sample_texture_ref(scene.textures, ref, uv, false, glm::vec4(1.0f));
+            metal += area * 0.25 * double(c.b);
+            rough += area * 0.25 * double(c.g);
+        }
+        area_sum += area;
+    }
+    if (area_sum > 0.0) {
+        s.metallic = std::clamp(float(double(s.metallic) * metal / area_sum), 0.0f, 1.0f);
+        s.roughness = std::clamp(float(double(s.roughness) * rough / area_sum), 0.0f, 1.0f);
+    }
+    return s;
 }
 
 ModelAsset describe_asset(const Scene& scene, uint32_t mesh) {

@@ -29,6 +29,15 @@ uint64_t material_fingerprint(const Scene& scene, uint32_t material);
 // its neural instances, fingerprints. Root, triangles and placement are the trainer's.
 ModelAsset describe_asset(const Scene& scene, uint32_t mesh);
 
+// Metallic and roughness of a neural asset's hits: a neural hit has no uv, so the material's factors
+// are multiplied by the metallic-roughness texture averaged over the mesh's surface (area-weighted,
+// sampled at 4 points per triangle). Without a texture: the factors. (The paper shades neural hits with
+// global constants; LSNIF predicts material parameters; the albedo here is learned, these are not.)
+struct AssetShading {
+    float metallic = 0.0f, roughness = 1.0f;
+};
+AssetShading asset_shading(const Scene& scene, uint32_t mesh);
+
 // Binds a model to a scene: the model's assets decide which instances are neural (every instance of a
 // glTF mesh the model has an asset for), meshes are split by material, and every neural mesh must
 // match its asset (name, geometry and material fingerprints). Returns, per scene mesh (after the

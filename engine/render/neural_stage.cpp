@@ -7,6 +7,7 @@
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
+#include "engine/neural/asset_table.h"
 #include "shaders/shared/scene_gpu.h"
 #include "shaders/shared/wavefront_gpu.h"
 
@@ -130,9 +131,14 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
         GpuNeuralAsset& g = assets_[a];
         for (uint32_t l = 0; l < NB_NEURAL_MAX_LODS; ++l) g.roots[l] = model_.lod_root(l, a);
         g.material = 0;
+        g.metallic = 0.0f;
+        g.roughness = 1.0f;
         for (uint32_t m = 0; m < scene.meshes.size(); ++m)
             if (asset_of_mesh(model, scene, m) == int32_t(a) && !scene.meshes[m].triangle_material.empty()) {
                 g.material = scene.meshes[m].triangle_material[0];
+                const AssetShading sh = asset_shading(scene, m);
+                g.metallic = sh.metallic;
+                g.roughness = sh.roughness;
                 break;
             }
         if (g.material >= std::max<size_t>(scene.materials.size(), 1)) g.material = 0;

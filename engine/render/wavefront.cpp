@@ -290,6 +290,24 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
             }
         }
     };
+    // The GPU's statistics counters are 32-bit and wrap within a long render (a 1080p frame at 4096 spp
+    // traces ~1e10 rays): they are read after every submission (each adds far less than 2^32) and the
+    // wrapped differences summed in 64 bits.
+    uint64_t totals[6] = {0, 0, 0, 0, 0, 0};
+    uint32_t last[6] = {0, 0, 0, 0, 0, 0};
+    auto tally = [&] {
+        const GpuQueueCounters c = buffers_[NB_BIND_COUNTERS].download<GpuQueueCounters>(1)[0];
+        uint32_t now[6] = {c.rays_primary, c.rays_secondary, c.rays_shadow, c.nonfinite_samples, 0, 0};
+        if (neural_) {
+            const GpuNeuralCounters nc = buffers_[NB_BIND_NEURAL_COUNTERS].download<GpuNeuralCounters>(1)[0];
+            now[4] = nc.queries_total;
+            now[5] = nc.rounds;
+        }
+        for (int k = 0; k < 6; ++k) {
+            totals[k] += uint32_t(now[k] - last[k]);
+            last[k] = now[k];
+        }
+    };
     // One submission per (sample, wave): bounded command buffers and timer slots at any spp.
     for (uint32_t sample = first; sample < first + count_samples; ++sample) {
         for (uint32_t offset = 0; offset < pixels; offset += capacity_) {
@@ -299,6 +317,7 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
             record_sample_wave(cmd_, sample, offset, count);
             cmd_.submit_and_wait();
             collect();
+            tally();
         }
     }
     cmd_.begin();
@@ -310,8 +329,6 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
 
     RenderResult result;
     if (read_back) result.image = read_output();
-    const GpuQueueCounters counters = buffers_[NB_BIND_COUNTERS].download<GpuQueueCounters>(1)[0];
-
     RenderStats& s = result.stats;
     s.device = ctx_.features().device_name;
     s.driver = ctx_.features().driver_name + " " + ctx_.features().driver_info;
@@ -321,15 +338,14 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
     s.max_depth = options_.max_depth;
     s.pass_ms = pass_ms;
     for (const auto& [name, ms] : pass_ms) s.gpu_ms += ms;
-    s.rays_primary = counters.rays_primary;
-    s.rays_secondary = counters.rays_secondary;
-    s.rays_shadow = counters.rays_shadow;
-    s.nonfinite_samples = counters.nonfinite_samples;
+    s.rays_primary = totals[0];
+    s.rays_secondary = totals[1];
+    s.rays_shadow = totals[2];
+    s.nonfinite_samples = totals[3];
     if (neural_) {
-        const GpuNeuralCounters nc = buffers_[NB_BIND_NEURAL_COUNTERS].download<GpuNeuralCounters>(1)[0];
         s.neural_path = neural_->kernel().describe();
-        s.neural_queries = nc.queries_total;
-        s.neural_rounds = nc.rounds;
+        s.neural_queries = totals[4];
+        s.neural_rounds = totals[5];
         for (const auto& [name, ms] : pass_ms)
             if (name == PASS_SHADERS[NEURAL_QUERY]) s.neural_query_ms += ms;
     }

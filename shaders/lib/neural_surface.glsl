@@ -1,8 +1,9 @@
 // The shading surface of a neural hit: position on the ray, the predicted normal (world space, turned
 // towards the incoming ray, used as geometric and shading normal), the predicted albedo as base colour
-// (it learned factor x texture), and the rest from the asset's glTF material: metallic, roughness,
-// transmission and emission factors (no textures: a neural hit has no uv), unless the user overrides
-// metallic/roughness (--neural-metallic, --neural-roughness). Included by passes/shade.comp after
+// (it learned factor x texture), and the rest from the asset's glTF material: metallic and roughness
+// as factor x the texture's mean over the asset (asset_table.h asset_shading: a neural hit has no uv),
+// transmission and emission factors, unless the user overrides metallic/roughness
+// (--neural-metallic, --neural-roughness). Included by passes/shade.comp after
 // lib/material.glsl.
 #ifndef NB_NEURAL_SURFACE_GLSL
 #define NB_NEURAL_SURFACE_GLSL
@@ -21,8 +22,8 @@ Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t) {
     s.ng = n;
     s.n = n;
     s.base = clamp(st.albedo, 0.0f, 1.0f);
-    float metallic = neural_params.metallic < 0.0f ? m.metallic : neural_params.metallic;
-    float roughness = neural_params.roughness < 0.0f ? m.roughness : neural_params.roughness;
+    float metallic = neural_params.metallic < 0.0f ? asset.metallic : neural_params.metallic;
+    float roughness = neural_params.roughness < 0.0f ? asset.roughness : neural_params.roughness;
     s.metallic = clamp(metallic, 0.0f, 1.0f);
     s.alpha = nb_ggx_alpha(clamp(roughness, 0.0f, 1.0f));
     bool from_material = neural_params.metallic < 0.0f && neural_params.roughness < 0.0f;

@@ -113,8 +113,10 @@ NB_STATIC_ASSERT(sizeof(GpuNeuralRayState) == 64, "GpuNeuralRayState layout");
 #define NB_NEURAL_MAX_LODS 8u
 struct GpuNeuralAsset {
     uint roots[NB_NEURAL_MAX_LODS]; // GPU node of its cut per LoD (LoDs past the model's: the coarsest)
-    uint material;                  // index into the scene materials
-    uint pad0, pad1, pad2;
+    uint material;                  // index into the scene materials (emission, transmission)
+    float metallic;                 // engine/neural/asset_table.h asset_shading: factor x mean texture
+    float roughness;
+    uint pad0;
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralAsset) == 48, "GpuNeuralAsset layout");
 

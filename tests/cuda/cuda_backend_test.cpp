@@ -60,6 +60,42 @@ double rel_l2(const std::vector<float>& a, const std::vector<double>& b) {
     return std::sqrt(num / std::max(den, 1e-300));
 }
 
+// The GPU's samples against the CPU backend's: same rays (same PCG32 streams; float differences in
+// sin/cos may move a rare ray, so 1 % may differ) and the same ground truth (hit, depth, normal, albedo
+// with per-hit texture lookups).
+uint32_t check_rays_and_truth(const TrainingAsset& asset, const TrainingCut& cut, const StepParams& p,
+                              const std::vector<CudaDebugSample>& samples) {
+    uint32_t same = 0;
+    for (uint32_t i = 0; i < p.batch_size; ++i) {
+        Pcg32 rng(p.seed ^ (uint64_t(p.step) * 0x9E3779B97F4A7C15ull), i);
+        uint64_t draws = 0;
+        const std::vector<const TrainingCut*> cuts{&cut};
+        const TrainingSample s = draw_training_sample(asset, cuts, rng, nullptr, draws);
+        if (s.leaf == samples[i].leaf && glm::length(s.origin - samples[i].origin) <= 1e-4f * glm::length(asset.bounds.extent()))
+            same++;
+    }
+    EXPECT_GE(same, p.batch_size * 99 / 100);
+
+    // 2. Ground truth: the GPU tracer agrees with the CPU tracer on hit/miss and depth.
+    uint32_t hit_mismatch = 0, depth_off = 0, normal_off = 0, albedo_off = 0;
+    for (const CudaDebugSample& s : samples) {
+        const GroundTruth gt = trace_ground_truth(asset, s.origin, s.dir, 0.0f, s.length);
+        if (gt.hit != (s.target[0] > 0.5f)) { hit_mismatch++; continue; }
+        if (!gt.hit) continue;
+        if (std::fabs(gt.depth - s.target[1]) > 1e-4f) depth_off++;
+        const glm::vec3 n((s.target[2] * 2 - 1), (s.target[3] * 2 - 1), (s.target[4] * 2 - 1));
+        if (glm::dot(n, gt.normal) < 0.999f) normal_off++;
+        const glm::vec3 al(s.target[5], s.target[6], s.target[7]);
+        if (glm::length(al - gt.albedo) > 1e-3f) albedo_off++;
+    }
+    EXPECT_LE(hit_mismatch, p.batch_size / 500);
+    EXPECT_LE(depth_off, p.batch_size / 500);
+    EXPECT_LE(normal_off, p.batch_size / 500);
+    EXPECT_LE(albedo_off, p.batch_size / 500);
+    return same;
+
+}
+
 void check_against_cpu(bool deterministic, uint32_t batch) {
     const Scene scene = load_bunny();
     const TrainingAsset asset = make_training_asset(scene, pick_neural_mesh(scene));
@@ -83,32 +119,7 @@ void check_against_cpu(bool deterministic, uint32_t batch) {
     std::vector<float> mlp_grad, grid_grad;
     gpu->read_last_step(samples, mlp_grad, grid_grad);
 
-    // 1. Same rays as the CPU backend's sampler (same PCG32 streams); float differences in sin/cos
-    //    may move a rare ray, so allow 1 %.
-    uint32_t same = 0;
-    for (uint32_t i = 0; i < p.batch_size; ++i) {
-        Pcg32 rng(p.seed ^ (uint64_t(p.step) * 0x9E3779B97F4A7C15ull), i);
-        uint64_t draws = 0;
-        const std::vector<const TrainingCut*> cuts{&cut};
-        const TrainingSample s = draw_training_sample(asset, cuts, rng, nullptr, draws);
-        if (s.leaf == samples[i].leaf && glm::length(s.origin - samples[i].origin) <= 1e-4f * glm::length(asset.bounds.extent()))
-            same++;
-    }
-    EXPECT_GE(same, p.batch_size * 99 / 100);
-
-    // 2. Ground truth: the GPU tracer agrees with the CPU tracer on hit/miss and depth.
-    uint32_t hit_mismatch = 0, depth_off = 0, normal_off = 0;
-    for (const CudaDebugSample& s : samples) {
-        const GroundTruth gt = trace_ground_truth(asset, s.origin, s.dir, 0.0f, s.length);
-        if (gt.hit != (s.target[0] > 0.5f)) { hit_mismatch++; continue; }
-        if (!gt.hit) continue;
-        if (std::fabs(gt.depth - s.target[1]) > 1e-4f) depth_off++;
-        const glm::vec3 n((s.target[2] * 2 - 1), (s.target[3] * 2 - 1), (s.target[4] * 2 - 1));
-        if (glm::dot(n, gt.normal) < 0.999f) normal_off++;
-    }
-    EXPECT_LE(hit_mismatch, p.batch_size / 500);
-    EXPECT_LE(depth_off, p.batch_size / 500);
-    EXPECT_LE(normal_off, p.batch_size / 500);
+    const uint32_t same = check_rays_and_truth(asset, cut, p, samples);
 
     // 3. Loss and gradients: CPU reference network (fp16-emulated forward = the shaders' rounding) on the
     //    GPU's samples and targets, with the initial weights (same init for the seed).
@@ -261,4 +272,54 @@ TEST(CudaBackend, HugeLearningRateIsCaughtByTheGuard) {
 }
 
 } // namespace
+// Several assets, one textured (base-colour texture with a KHR_texture_transform): the CUDA sampler
+// picks the part and searches its subtree as the CPU does, and its ground truth samples the texture
+// per hit (was: per vertex) to the CPU's values.
+TEST(CudaBackend, MultiAssetTexturedTruthMatchesCpu) {
+    REQUIRE_GPU();
+    Scene s = test::scene_of(test::cube(1.0f));
+    Texture tex;
+    tex.width = 16;
+    tex.height = 8;
+    tex.srgb = true;
+    for (uint32_t y = 0; y < tex.height; ++y)
+        for (uint32_t x = 0; x < tex.width; ++x)
+            for (uint8_t c : {uint8_t(x * 16), uint8_t(y * 32), uint8_t(((x ^ y) & 1) * 255), uint8_t(255)})
+                tex.rgba8.push_back(c);
+    s.textures.push_back(tex);
+    s.materials[0].base_color_tex.texture = 0;
+    s.materials[0].base_color_tex.transform = glm::mat3(glm::vec3(2.0f, 0.0f, 0.0f), glm::vec3(0.0f, 1.5f, 0.0f),
+                                                        glm::vec3(0.25f, 0.1f, 1.0f));
+    Mesh& m0 = s.meshes[0];
+    m0.uv0.clear();
+    for (const glm::vec3& p : m0.positions) m0.uv0.push_back(glm::vec2(p.x + 0.3f * p.z, p.y - 0.2f * p.z));
+    for (int k = 1; k < 3; ++k) {
+        Mesh m = test::cube(0.4f + 0.3f * float(k), glm::vec3(float(k), 0.0f, 0.0f));
+        m.name = "cube" + std::to_string(k);
+        m.triangle_material.assign(m.triangle_count(), 0u);
+        m.uv0.assign(m.positions.size(), glm::vec2(0.1f * float(k), 0.7f));
+        s.meshes.push_back(std::move(m));
+        Instance i;
+        i.mesh = uint32_t(k);
+        i.neural = true;
+        s.instances.push_back(i);
+    }
+    const TrainingAsset asset = make_training_asset(s, neural_meshes(s));
+    ASSERT_EQ(asset.parts.size(), 3u);
+    TrainingCut cut = cut_at_depth(asset, 5);
+    auto gpu = make_cuda_backend_ex(asset, NeuralConfig{.log2_hash_size = 14}, neural::AdamConfig{}, CudaBackendOptions{}, 7);
+    StepParams p;
+    p.step = 1;
+    p.batch_size = 4096;
+    p.seed = 5;
+    p.cuts = {&cut};
+    p.cut_version = 1;
+    const StepStats st = gpu->step(p);
+    ASSERT_FALSE(st.skipped) << st.skip_reason;
+    std::vector<CudaDebugSample> samples;
+    std::vector<float> mlp_grad, grid_grad;
+    gpu->read_last_step(samples, mlp_grad, grid_grad);
+    check_rays_and_truth(asset, cut, p, samples);
+}
+
 } // namespace nbvh

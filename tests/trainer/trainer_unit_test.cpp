@@ -10,7 +10,7 @@
 #include "trainer/cpu/cpu_backend.h"
 #include "trainer/ground_truth.h"
 #include "trainer/model_export.h"
-#include "trainer/texture_sampler.h"
+#include "engine/scene/texture_sampler.h"
 #include "trainer/trainer.h"
 
 using namespace nbvh;

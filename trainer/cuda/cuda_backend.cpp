@@ -13,7 +13,7 @@
 #include "engine/neural/adam.h"
 #include "engine/neural/losses.h"
 #include "trainer/cuda/cuda_core.h"
-#include "trainer/texture_sampler.h"
+#include "engine/scene/texture_sampler.h"
 
 namespace nbvh {
 namespace {
@@ -39,6 +39,27 @@ cuda::CoreAsset flatten_asset(const TrainingAsset& asset) {
     a.tri_normals.resize(size_t(tris) * 9);
     a.tri_albedo.resize(size_t(tris) * 9);
     a.tri_geo_normal.resize(size_t(tris) * 3);
+    a.tri_uv.assign(size_t(tris) * 6, 0.0f);
+    a.tri_texture.assign(tris, -1);
+    // Base-colour textures used by the asset, packed RGBA8 (R in the low byte), uploaded once.
+    std::vector<int32_t> slot_of(scene.textures.size(), -1);
+    auto texture_slot = [&](uint32_t t) {
+        if (slot_of[t] < 0) {
+            const Texture& tex = scene.textures[t];
+            slot_of[t] = int32_t(a.texture_info.size() / 3);
+            const bool ok = tex.width > 0 && tex.height > 0 && tex.rgba8.size() >= size_t(tex.width) * tex.height * 4;
+            a.texture_info.push_back(uint32_t(a.texels.size()));
+            a.texture_info.push_back(ok ? tex.width : 1u);
+            a.texture_info.push_back(ok ? tex.height : 1u);
+            if (!ok) a.texels.push_back(0xFFFFFFFFu);
+            else
+                for (size_t p = 0; p < size_t(tex.width) * tex.height; ++p)
+                    a.texels.push_back(uint32_t(tex.rgba8[4 * p]) | (uint32_t(tex.rgba8[4 * p + 1]) << 8) |
+                                       (uint32_t(tex.rgba8[4 * p + 2]) << 16) | (uint32_t(tex.rgba8[4 * p + 3]) << 24));
+        }
+        return slot_of[t];
+    };
+    for (int i = 0; i < 256; ++i) a.srgb_table[size_t(i)] = srgb_to_linear(float(i) / 255.0f);
     const bool has_normals = m.normals.size() == m.positions.size();
     for (uint32_t k = 0; k < tris; ++k) {
         const uint32_t tri = mb.bvh.prim_indices[k];
@@ -47,17 +68,22 @@ cuda::CoreAsset flatten_asset(const TrainingAsset& asset) {
         const Material* material = mat < scene.materials.size() ? &scene.materials[mat] : nullptr;
         const uint32_t uv_set = material ? material->base_color_tex.uv_set : 0u;
         const std::vector<glm::vec2>& uvs = uv_set == 1u ? m.uv1 : m.uv0;
+        // Base-colour texture of the triangle (device index) and its uvs with the texture transform
+        // applied (affine: exact under interpolation); the kernel samples it per hit, as the CPU does.
+        int32_t dev_tex = -1;
+        if (material && material->base_color_tex.texture >= 0 && uvs.size() == m.positions.size() &&
+            size_t(material->base_color_tex.texture) < scene.textures.size())
+            dev_tex = texture_slot(uint32_t(material->base_color_tex.texture));
+        a.tri_texture[k] = dev_tex;
         for (int c = 0; c < 3; ++c) {
             const glm::vec3 p = mb.vertices[size_t(k) * 3 + c];
             const glm::vec3 n = has_normals ? m.normals[idx[c]] : glm::vec3(0.0f);
-            // Albedo per vertex (factor x texture at the vertex uv), interpolated on the GPU: exact for
-            // untextured materials, an approximation of the CPU's per-hit texture lookup otherwise.
-            glm::vec3 al(0.9f);
-            if (material) {
-                al = glm::vec3(material->base_color);
-                if (uvs.size() == m.positions.size() && material->base_color_tex.texture >= 0)
-                    al *= glm::vec3(sample_texture_ref(scene.textures, material->base_color_tex, uvs[idx[c]], true,
-                                                       glm::vec4(1.0f)));
+            glm::vec3 al(0.9f); // official default material base colour when none is given (notes §6.7)
+            if (material) al = glm::vec3(material->base_color);
+            if (dev_tex >= 0) {
+                const glm::vec3 uv = material->base_color_tex.transform * glm::vec3(uvs[idx[c]], 1.0f);
+                a.tri_uv[size_t(k) * 6 + c * 2] = uv.x;
+                a.tri_uv[size_t(k) * 6 + c * 2 + 1] = uv.y;
             }
             if (!std::isfinite(al.x + al.y + al.z)) al = glm::vec3(0.9f);
             for (int q = 0; q < 3; ++q) {

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <array>
 #include <vector>
 
 #include "shaders/shared/bvh_node.h"
@@ -23,7 +24,12 @@ struct CoreAsset {
     std::vector<GpuBvhNode> mesh_nodes;
     std::vector<float> tri_vertices;    // 9 per triangle (leaf order)
     std::vector<float> tri_normals;     // 9 per triangle: unit vertex normals (leaf order)
-    std::vector<float> tri_albedo;      // 9 per triangle: per-vertex albedo (factor x texture at the vertex uv)
+    std::vector<float> tri_albedo;      // 9 per triangle: per-vertex base colour factor
+    std::vector<float> tri_uv;          // 6 per triangle: base-colour uvs (texture transform applied)
+    std::vector<int32_t> tri_texture;   // per triangle: base-colour texture (index into texture_info) or -1
+    std::vector<uint32_t> texels;       // RGBA8 packed, R in the low byte, all textures
+    std::vector<uint32_t> texture_info; // 3 per texture: first texel, width, height
+    std::array<float, 256> srgb_table{}; // engine/core/image.h srgb_to_linear(i / 255), as the CPU sampler
     std::vector<float> tri_geo_normal;  // 3 per triangle: unit geometric normal (fallback)
     GpuEncodingBox encoding;
     // Parts of a multi-asset run (trainer/training_asset.h TrainingPart): sampling box (lo xyz, extent

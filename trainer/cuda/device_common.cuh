@@ -49,7 +49,12 @@ struct DevAsset {
     const GpuBvhNode* mesh_nodes = nullptr;
     const float* tri_v = nullptr;        // 9 per triangle
     const float* tri_n = nullptr;        // 9 per triangle
-    const float* tri_a = nullptr;        // 9 per triangle
+    const float* tri_a = nullptr;        // 9 per triangle: base colour factor per vertex
+    const float* tri_uv = nullptr;       // 6 per triangle
+    const int32_t* tri_tex = nullptr;    // per triangle, -1 = untextured
+    const uint32_t* texels = nullptr;
+    const uint32_t* tex_info = nullptr;  // 3 per texture: first texel, width, height
+    const float* srgb = nullptr;         // 256 entries
     const float* tri_g = nullptr;        // 3 per triangle
     GpuEncodingBox enc;
     const float* part_boxes = nullptr;    // 6 per part: sampling box lo xyz, extent xyz

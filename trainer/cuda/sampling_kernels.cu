@@ -194,6 +194,29 @@ __device__ bool closest_hit(const DevAsset& a, vec3 o, vec3 d, float tmin, float
     return hit;
 }
 
+// engine/scene/texture_sampler.cpp sample_texture_bilinear with srgb = true, RGB only (same float
+// operations: sRGB decoded per texel through the same table, then filtered; REPEAT wrap).
+__device__ vec3 sample_base_colour(const DevAsset& a, int32_t tex, float u, float v) {
+    const uint32_t first = a.tex_info[3 * tex], w = a.tex_info[3 * tex + 1], h = a.tex_info[3 * tex + 2];
+    if (!isfinite(u) || !isfinite(v)) u = v = 0.0f;
+    u -= floorf(u);
+    v -= floorf(v);
+    const float x = u * float(w) - 0.5f, y = v * float(h) - 0.5f;
+    const float fx = floorf(x), fy = floorf(y);
+    const float ax = x - fx, ay = y - fy;
+    auto wrap = [](int i, int n) { const int m = i % n; return m < 0 ? m + n : m; };
+    const int x0 = wrap(int(fx), int(w)), y0 = wrap(int(fy), int(h));
+    const int x1 = wrap(x0 + 1, int(w)), y1 = wrap(y0 + 1, int(h));
+    auto texel = [&](int tx, int ty) {
+        const uint32_t c = a.texels[first + uint32_t(ty) * w + uint32_t(tx)];
+        return vec3(a.srgb[c & 0xFFu], a.srgb[(c >> 8) & 0xFFu], a.srgb[(c >> 16) & 0xFFu]);
+    };
+    // glm::mix(p, q, t) = p * (1 - t) + q * t
+    const vec3 top = texel(x0, y0) * (1.0f - ax) + texel(x1, y0) * ax;
+    const vec3 bottom = texel(x0, y1) * (1.0f - ax) + texel(x1, y1) * ax;
+    return top * (1.0f - ay) + bottom * ay;
+}
+
 __global__ void k_ground_truth(DevAsset a, DevBatch b) {
     const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= b.n) return;
@@ -212,6 +235,13 @@ __global__ void k_ground_truth(DevAsset a, DevBatch b) {
             n = (nl > 1e-12f && isfinite(nl)) ? n / nl : load3(a.tri_g + size_t(tri) * 3);
             const float* ta = a.tri_a + size_t(tri) * 9;
             vec3 al = load3(ta) * w + load3(ta + 3) * u + load3(ta + 6) * v;
+            const int32_t tex = a.tri_tex[tri];
+            if (tex >= 0) {
+                const float* tu = a.tri_uv + size_t(tri) * 6;
+                const float uu = tu[0] * w + tu[2] * u + tu[4] * v, vv = tu[1] * w + tu[3] * u + tu[5] * v;
+                const vec3 c = sample_base_colour(a, tex, uu, vv);
+                al = vec3(al.x * c.x, al.y * c.y, al.z * c.z);
+            }
             al = clamp(al, vec3(0.0f), vec3(1.0f));
             tg[0] = 1.0f;
             tg[1] = nb_encode_depth_target(a.enc, t, 0.0f, len, false);

@@ -1,4 +1,4 @@
-#include "trainer/texture_sampler.h"
+#include "engine/scene/texture_sampler.h"
 
 #include <array>
 #include <cmath>

@@ -1,5 +1,5 @@
-// CPU texture fetch for the trainer's ground truth: bilinear, wrap (glTF default sampler), with the
-// KHR_texture_transform of the reference applied. Base-colour texels are sRGB-encoded 8-bit and are
+// CPU texture fetch (the trainer's ground truth, neural assets' material constants): bilinear, wrap
+// (glTF default sampler), with the KHR_texture_transform of the reference applied. Base-colour texels are sRGB-encoded 8-bit and are
 // decoded to linear here, so the albedo target is linear RGB (the official code skips the decode,
 // notes §14; we follow glTF).
 #pragma once
