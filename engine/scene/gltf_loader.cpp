@@ -17,6 +17,7 @@
 #include "engine/scene/gltf_accessor.h"
 #include "engine/scene/gltf_material.h"
 #include "engine/scene/gltf_schema.h"
+#include "engine/scene/gltf_support.h"
 #include "engine/scene/mesh_builder.h"
 #include "engine/scene/scene_stats.h"
 
@@ -100,6 +101,9 @@ tinygltf::Model parse_file(const std::filesystem::path& path, bool keep_textures
     std::string err, warn;
     const bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, file)
                            : loader.LoadASCIIFromFile(&model, &err, &warn, file);
+    // Before tinygltf's own error: a parse that failed on buffers only a required extension can decode
+    // (meshopt fallback buffers have no uri) is explained by the extension.
+    gltf::check_required_extensions(model.extensionsRequired, file);
     std::istringstream lines(warn);
     for (std::string line; std::getline(lines, line);)
         if (!line.empty()) log_warn("%s: %s", path.filename().string().c_str(), line.c_str());
@@ -191,6 +195,7 @@ public:
 
     Scene load() {
         model_ = parse_file(path_, options_.keep_textures);
+        gltf::warn_ignored_features(model_, file_);
         scene_.source = path_.string();
         default_material_ = gltf::convert_materials(model_, options_.keep_textures, scene_);
         check_node_graph(model_, file_);
