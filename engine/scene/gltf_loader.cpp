@@ -16,6 +16,7 @@
 #include "engine/core/log.h"
 #include "engine/scene/gltf_accessor.h"
 #include "engine/scene/gltf_material.h"
+#include "engine/scene/gltf_pose.h"
 #include "engine/scene/gltf_schema.h"
 #include "engine/scene/gltf_support.h"
 #include "engine/scene/mesh_builder.h"
@@ -26,6 +27,8 @@ namespace {
 
 // World-space limit (metres): float32 ray-triangle and normal math overflows beyond ~1e9 (|x|^4 > 3.4e38).
 constexpr float MAX_WORLD_COORDINATE = 1e9f;
+// Vertices in per-node posed copies of skinned or morphed meshes (~2 GB of vertex data at most).
+constexpr uint64_t MAX_POSED_VERTICES = uint64_t(1) << 25;
 
 std::string first_line(const std::string& s) {
     std::string line = s.substr(0, s.find('\n'));
@@ -273,13 +276,89 @@ private:
             log_warn("%s: node %d refers to mesh %d which does not exist; skipped", file_.c_str(), node_index, node.mesh);
             return;
         }
-        const int32_t mesh = scene_mesh(node.mesh);
-        if (mesh < 0) return;
         Instance inst;
         inst.name = node.name.empty() ? strfmt("node%d", node_index) : node.name;
+        // Skinned, or morphed by weights of its own: this node gets its own posed copy of the mesh
+        // (gltf_pose.h); a skinned one is in world space, as the node's own transform does not apply.
+        gltf::Pose pose;
+        if (node.skin >= 0) {
+            node_world_transforms();
+            const std::string what = strfmt("%s: node %d ('%s')", file_.c_str(), node_index, node.name.c_str());
+            if (gltf::skin_joints(model_, node.skin, world_, world_valid_, pose.joints, what)) pose.unskinned = world;
+        }
+        const bool own_weights = !node.weights.empty() && has_targets(node.mesh);
+        int32_t mesh = -1;
+        if ((pose.skinned() || own_weights) && posed_copy_fits(node.mesh)) {
+            pose.weights = gltf::morph_weights(model_, node_index, node.mesh);
+            skinned_instances_ += pose.skinned();
+            mesh = add_mesh(build(node.mesh, pose, inst.name), node.mesh);
+        } else {
+            pose = gltf::Pose{};
+            mesh = scene_mesh(node.mesh);
+        }
+        if (mesh < 0) return;
         inst.mesh = uint32_t(mesh);
-        inst.object_to_world = glm::mat4(world);
+        inst.object_to_world = pose.skinned() ? glm::mat4(1.0f) : glm::mat4(world);
         scene_.instances.push_back(std::move(inst));
+    }
+
+    // Posed copies are not shared between nodes: their vertices are capped (a hostile file could pose one
+    // large mesh on thousands of nodes); past the cap nodes share the unposed mesh, warned once.
+    bool posed_copy_fits(int m) {
+        uint64_t vertices = 0;
+        for (size_t p = 0; p < model_.meshes[size_t(m)].primitives.size(); ++p) {
+            const auto& attributes = model_.meshes[size_t(m)].primitives[p].attributes;
+            auto a = attributes.find("POSITION");
+            if (a != attributes.end())
+                vertices += gltf::accessor_count(model_, a->second, strfmt("%s: mesh %d primitive %zu POSITION",
+                                                                            file_.c_str(), m, p));
+        }
+        if (posed_vertices_ + vertices <= MAX_POSED_VERTICES) {
+            posed_vertices_ += vertices;
+            return true;
+        }
+        if (!posed_cap_warned_)
+            log_warn("%s: skinned/morphed copies exceed %llu vertices; further nodes show their mesh unposed",
+                     file_.c_str(), (unsigned long long)MAX_POSED_VERTICES);
+        posed_cap_warned_ = true;
+        return false;
+    }
+
+    bool has_targets(int m) const {
+        for (const tinygltf::Primitive& p : model_.meshes[size_t(m)].primitives)
+            if (!p.targets.empty()) return true;
+        return false;
+    }
+
+    // World transform of every node through its parent chain, whatever scene it is in (skin joints need
+    // not be under the skinned node). The graph is acyclic (check_node_graph); a second parent is ignored
+    // as in traverse(). world_valid_[n] = 0 where a transform on the chain is not finite.
+    void node_world_transforms() {
+        const size_t n = model_.nodes.size();
+        if (world_.size() == n) return;
+        std::vector<int> parent(n, -1);
+        for (size_t i = 0; i < n; ++i)
+            for (int c : model_.nodes[i].children)
+                if (parent[size_t(c)] < 0) parent[size_t(c)] = int(i);
+        world_.assign(n, glm::dmat4(1.0));
+        world_valid_.assign(n, 0);
+        std::vector<uint8_t> done(n, 0);
+        std::vector<size_t> chain;
+        for (size_t i = 0; i < n; ++i) {
+            chain.clear();
+            for (size_t k = i; !done[k]; k = size_t(parent[k])) {
+                chain.push_back(k);
+                if (parent[k] < 0) break;
+            }
+            for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+                const size_t k = *it;
+                const int p = parent[k];
+                glm::dmat4 local;
+                world_valid_[k] = local_transform(model_.nodes[k], local) && (p < 0 || world_valid_[size_t(p)]);
+                if (world_valid_[k]) world_[k] = p < 0 ? local : world_[size_t(p)] * local;
+                done[k] = 1;
+            }
+        }
     }
 
     void add_camera(const tinygltf::Node& node, const glm::dmat4& world) {
@@ -310,19 +389,28 @@ private:
     int32_t scene_mesh(int m) {
         auto it = mesh_map_.find(m);
         if (it != mesh_map_.end()) return it->second;
-        Mesh mesh = build(m);
-        int32_t slot = -1;
-        if (mesh.triangle_count() > 0) {
-            slot = int32_t(scene_.meshes.size());
-            scene_.meshes.push_back(std::move(mesh));
-        }
+        // Shared by every node without a pose of its own: morph targets at the mesh's default weights.
+        gltf::Pose pose;
+        if (has_targets(m)) pose.weights = gltf::morph_weights(model_, -1, m);
+        const int32_t slot = add_mesh(build(m, pose), m);
         mesh_map_[m] = slot;
         return slot;
     }
 
-    Mesh build(int m) {
+    // Keeps a mesh with triangles (returns its Scene::meshes index, else -1).
+    int32_t add_mesh(Mesh mesh, int gltf_mesh) {
+        if (mesh.triangle_count() == 0) return -1;
+        scene_.meshes.push_back(std::move(mesh));
+        gltf_mesh_of_.push_back(gltf_mesh);
+        return int32_t(scene_.meshes.size() - 1);
+    }
+
+    // glTF mesh `m` as one Mesh, posed by `pose`; a node's own posed copy is named "mesh@node".
+    Mesh build(int m, const gltf::Pose& pose, const std::string& node_name = "") {
         const tinygltf::Mesh& src = model_.meshes[size_t(m)];
-        const std::string name = src.name.empty() ? strfmt("mesh%d", m) : src.name;
+        std::string name = src.name.empty() ? strfmt("mesh%d", m) : src.name;
+        if (!node_name.empty()) name += "@" + node_name;
+        morphed_meshes_ += pose.morphed() && has_targets(m);
         std::vector<PrimitiveData> prims;
         std::map<std::string, int> skipped_modes;
         for (size_t p = 0; p < src.primitives.size(); ++p) {
@@ -362,6 +450,7 @@ private:
             d.needs_tangents = mat.normal_tex.texture >= 0;
             d.normal_map_uv_set = mat.normal_tex.uv_set;
             if (d.needs_tangents) optional("TANGENT", 4, d.tangents);
+            if (pose.morphed() || pose.skinned()) gltf::apply_pose(model_, prim, pose, d, what);
             if (prim.indices >= 0) {
                 d.indices = gltf::read_indices(model_, prim.indices, what + " indices");
             } else {
@@ -429,6 +518,10 @@ private:
             how = mark_neural_by_scene();
         }
         log_info("%s; neural: %s", describe(scene_).c_str(), how.c_str());
+        if (skinned_instances_ || morphed_meshes_)
+            log_info("%s: %u skinned instance%s posed by the joints' node transforms, %u mesh%s morphed at the default "
+                     "weights (no animation is played)", file_.c_str(), skinned_instances_,
+                     skinned_instances_ == 1 ? "" : "s", morphed_meshes_, morphed_meshes_ == 1 ? "" : "es");
     }
 
     // ARCHITECTURE.md "Which assets are neural": nodes of a "*_neural" scene are neural. That scene holds its
@@ -451,11 +544,8 @@ private:
             });
         }
         if (used.empty()) return "none";
-        std::map<int32_t, int> scene_to_gltf; // Scene::meshes index -> glTF mesh
-        for (const auto& [g, s] : mesh_map_)
-            if (s >= 0) scene_to_gltf[s] = g;
         for (Instance& inst : scene_.instances)
-            inst.neural = keys.count({inst.name, scene_to_gltf[int32_t(inst.mesh)]}) > 0;
+            inst.neural = keys.count({inst.name, gltf_mesh_of_[inst.mesh]}) > 0;
         return used;
     }
 
@@ -466,7 +556,13 @@ private:
     Scene scene_;
     uint32_t default_material_ = 0;
     int scene_index_ = -1;
-    std::map<int, int32_t> mesh_map_; // glTF mesh -> Scene::meshes index (-1: no triangles)
+    std::map<int, int32_t> mesh_map_; // glTF mesh -> Scene::meshes index (-1: no triangles), unposed nodes
+    std::vector<int> gltf_mesh_of_;   // Scene::meshes index -> glTF mesh
+    std::vector<glm::dmat4> world_;   // node_world_transforms()
+    std::vector<uint8_t> world_valid_;
+    uint32_t skinned_instances_ = 0, morphed_meshes_ = 0;
+    uint64_t posed_vertices_ = 0; // in posed copies (posed_copy_fits)
+    bool posed_cap_warned_ = false;
 };
 
 } // namespace
