@@ -96,7 +96,12 @@ void run_render(const RenderArgs& a) {
     if (a.env_rotation) env.rotation = *a.env_rotation * 3.14159265358979f / 180.0f;
     const Camera camera = choose_camera(scene, a.camera, a.options);
     if (a.explain) {
-        std::printf("%s", render::explain(render::derive_features(scene, env), a.options.max_depth).c_str());
+        // A hybrid render's neural stage is built on the device, as the renderer builds it (its kernel).
+        std::optional<vk::Context> ectx;
+        if (options.neural.model) ectx.emplace(copt);
+        const auto plan = render::plan_neural(ectx ? &*ectx : nullptr, scene, options.neural);
+        std::printf("%s", render::explain(render::derive_features(scene, env, options.neural), options.max_depth,
+                                          plan ? &*plan : nullptr).c_str());
         return;
     }
     vk::Context ctx(copt); // before the BVH build: a missing device fails fast

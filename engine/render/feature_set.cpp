@@ -1,5 +1,8 @@
 #include "engine/render/feature_set.h"
 
+#include <algorithm>
+
+#include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "shaders/shared/scene_gpu.h"
 
@@ -12,9 +15,23 @@ bool texture_exists(const Scene& scene, const TextureRef& ref) {
            scene.textures[size_t(ref.texture)].width > 0 && scene.textures[size_t(ref.texture)].height > 0;
 }
 
+std::string neural_rounds_text(const NeuralPlan& n, const char* traverse, const char* what) {
+    std::string s;
+    s += strfmt("    %-26s op 0: %s, queues (ray, leaf) pairs (indirect)\n", traverse, what);
+    if (n.batched_rounds > 0) {
+        s += strfmt("    repeat %u x (batched rounds):\n", n.batched_rounds);
+        s += "      passes/neural_args.comp    queued pairs -> indirect dispatch arguments\n";
+        s += strfmt("      %-26s hash grid + MLP of the queued pairs\n", n.query_shader.c_str());
+        s += strfmt("      %-26s op 1: resume the queried rays, queue their next leaves\n", traverse);
+    }
+    s += "    passes/neural_args.comp    rays still going -> indirect dispatch arguments\n";
+    s += "    passes/neural_tail.comp    finishes them (scalar queries inline)\n";
+    return s;
+}
+
 } // namespace
 
-SceneFeatures derive_features(const Scene& scene, const Environment& environment) {
+SceneFeatures derive_features(const Scene& scene, const Environment& environment, const NeuralRenderOptions& neural) {
     SceneFeatures f;
     // Only materials that some instanced triangle uses matter.
     std::vector<bool> used(scene.materials.size(), false);
@@ -38,8 +55,9 @@ SceneFeatures derive_features(const Scene& scene, const Environment& environment
         if (m.alpha_mode != AlphaMode::opaque) f.alpha_mask = true;
         if (m.transmission > 0.0f && m.metallic < 1.0f) f.transmission = true;
     }
-    for (const Instance& inst : scene.instances) f.neural = f.neural || inst.neural;
-    f.neural = false; // the neural passes arrive with the neural issue; neural instances render as triangles
+    // Without a model (or with --classical) neural instances render from their triangles.
+    if (neural.model && !neural.classical)
+        for (const Instance& inst : scene.instances) f.neural = f.neural || inst.neural;
     f.environment = !environment.empty() && environment.intensity > 0.0f;
     return f;
 }
@@ -51,11 +69,56 @@ std::vector<vk::SpecConstant> specialization(const SceneFeatures& f) {
             {NB_SC_NEURAL, f.neural ? 1u : 0u}};
 }
 
-std::vector<std::string> pass_list(const SceneFeatures& f) {
-    std::vector<std::string> passes = {"passes/camera_rays.comp", "passes/queue_args.comp", "passes/traverse.comp",
-                                       "passes/shade.comp"};
+std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene, const NeuralRenderOptions& o) {
+    if (!o.model || o.classical) return std::nullopt;
+    validate(o, scene); // throws what the renderer would
+    NBVH_CHECK_MSG(ctx != nullptr, "plan_neural: a hybrid render needs the device to choose its kernel");
+    // The renderer's own stage (ray capacity 1: only its choices are read, no ray buffers are installed).
+    const NeuralStage stage(*ctx, *o.model, scene, o, 1);
+    NeuralPlan p;
+    p.kernel = stage.kernel().describe();
+    p.query_shader = stage.query_shader();
+    p.lod_primary = stage.params().lod_primary;
+    p.lod_secondary = stage.params().lod_secondary;
+    p.lod_count = std::max(1u, o.model->lod_count);
+    p.leaf_budget = stage.rounds();
+    p.leaves_per_round = stage.leaves_per_round();
+    p.batched_rounds = stage.batched_rounds();
+    for (const Instance& inst : scene.instances) p.instances += inst.neural;
+    p.assets = uint32_t(o.model->assets.size());
+    return p;
+}
+
+namespace {
+
+// The neural rounds of one traversal (WavefrontRenderer::record_neural_rounds): op 0 over every ray, then
+// per batched round the query of the queued pairs and the resumed traversal, then neural_tail.
+void neural_rounds(std::vector<std::string>& passes, const NeuralPlan& n, const char* traverse) {
+    passes.push_back(traverse);
+    for (uint32_t r = 0; r < n.batched_rounds; ++r) {
+        passes.push_back("passes/neural_args.comp");
+        passes.push_back(n.query_shader);
+        passes.push_back(traverse);
+    }
+    passes.push_back("passes/neural_args.comp");
+    passes.push_back("passes/neural_tail.comp");
+}
+
+} // namespace
+
+std::vector<std::string> pass_list(const SceneFeatures& f, const NeuralPlan* neural) {
+    const NeuralPlan* n = f.neural ? neural : nullptr;
+    std::vector<std::string> passes = {"passes/camera_rays.comp", "passes/queue_args.comp"};
+    if (n) {
+        neural_rounds(passes, *n, "passes/neural_traverse.comp");
+        passes.push_back("passes/neural_traverse.comp"); // op 2: closest hit of triangles and neural leaves
+    } else {
+        passes.push_back("passes/traverse.comp");
+    }
+    passes.push_back("passes/shade.comp");
     if (f.has_lights()) {
         passes.push_back("passes/queue_args.comp");
+        if (n) neural_rounds(passes, *n, "passes/neural_shadow.comp");
         passes.push_back("passes/shadow.comp");
     }
     passes.push_back("passes/accumulate.comp");
@@ -63,7 +126,8 @@ std::vector<std::string> pass_list(const SceneFeatures& f) {
     return passes;
 }
 
-std::string explain(const SceneFeatures& f, uint32_t max_depth) {
+std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan* neural) {
+    const NeuralPlan* n = f.neural ? neural : nullptr;
     auto yn = [](bool b) { return b ? "yes" : "no"; };
     std::string s;
     s += "scene features:\n";
@@ -74,15 +138,32 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth) {
                 f.environment ? "  (importance-sampled environment NEE + MIS)" : "");
     s += strfmt("  alpha masks     %s%s\n", yn(f.alpha_mask), f.alpha_mask ? "  (alpha test in traversal)" : "");
     s += strfmt("  transmission    %s\n", yn(f.transmission));
-    s += strfmt("  neural assets   %s\n", yn(f.neural));
+    if (n) {
+        s += strfmt("  neural assets   yes  (%u instance%s answered by the model's %u asset%s)\n", n->instances,
+                    n->instances == 1 ? "" : "s", n->assets, n->assets == 1 ? "" : "s");
+        s += "neural stage:\n";
+        s += strfmt("  MLP path        %s\n", n->kernel.c_str());
+        s += strfmt("  LoD             camera rays %u, after the first hit %u (the model has %u: 0 = finest)\n",
+                    n->lod_primary, n->lod_secondary, n->lod_count);
+        s += strfmt("  leaves per ray  at most %u, %u queued per round: %u batched round%s, then neural_tail\n",
+                    n->leaf_budget, n->leaves_per_round, n->batched_rounds, n->batched_rounds == 1 ? "" : "s");
+    } else {
+        s += strfmt("  neural assets   %s\n", yn(f.neural));
+    }
     s += strfmt("passes per sample wave (max depth %u):\n", max_depth);
     s += "  passes/camera_rays.comp      one ray per pixel -> ray queue\n";
     s += strfmt("  repeat %u x:\n", max_depth);
     s += "    passes/queue_args.comp     ray counter -> indirect dispatch arguments\n";
-    s += "    passes/traverse.comp       TLAS/BLAS closest hit (indirect)\n";
+    if (n) {
+        s += neural_rounds_text(*n, "passes/neural_traverse.comp", "closest hit through triangles and N-BVHs");
+        s += "    passes/neural_traverse.comp  op 2: closest of triangle and accepted neural hits (indirect)\n";
+    } else {
+        s += "    passes/traverse.comp       TLAS/BLAS closest hit (indirect)\n";
+    }
     s += "    passes/shade.comp          BSDF, emission, light sampling, next ray (indirect)\n";
     if (f.has_lights()) {
         s += "    passes/queue_args.comp     shadow counter -> indirect dispatch arguments\n";
+        if (n) s += neural_rounds_text(*n, "passes/neural_shadow.comp", "visibility through N-BVHs");
         s += "    passes/shadow.comp         any-hit visibility of light samples (indirect)\n";
     } else {
         s += "    (no shadow pass: nothing to sample by next-event estimation)\n";

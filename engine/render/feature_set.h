@@ -2,10 +2,13 @@
 // the effects a scene calls for"). It decides the specialization constants of every pass and which
 // passes run at all (no shadow pass without anything to sample, no texture fetch without textures).
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "engine/render/neural_stage.h"
 #include "engine/scene/scene.h"
+#include "engine/vk/context.h"
 #include "engine/vk/pipeline.h"
 
 namespace nbvh::render {
@@ -17,26 +20,46 @@ struct SceneFeatures {
     bool environment = false;   // an environment (map or constant) lights the scene (-> env NEE)
     bool alpha_mask = false;    // masked or blended materials (-> alpha test in traversal)
     bool transmission = false;  // KHR_materials_transmission
-    bool neural = false;        // neural instances (next issue; always false here)
+    bool neural = false;        // hybrid render: neural instances answered by the model's N-BVH + MLP
 
     // Any light that next-event estimation can sample: the shadow pass runs only then.
     bool has_lights() const { return emission || environment; }
     bool operator==(const SceneFeatures&) const = default;
 };
 
-// Derives the features from the scene and the environment the render will use (`environment` may
-// differ from scene.environment: --env, or the default sky). Emission counts only materials that are
-// referenced by a triangle of an instanced mesh.
-SceneFeatures derive_features(const Scene& scene, const Environment& environment);
+// Derives the features from the scene, the environment the render will use (`environment` may differ
+// from scene.environment: --env, or the default sky) and the neural options (neural: a model is given,
+// not --classical, and some instance is neural). Emission counts only materials that are referenced by a
+// triangle of an instanced mesh.
+SceneFeatures derive_features(const Scene& scene, const Environment& environment,
+                              const NeuralRenderOptions& neural = {});
+
+// What the neural stage of a hybrid render runs (engine/render/NEURAL.md), read from a NeuralStage.
+struct NeuralPlan {
+    std::string kernel;            // MLP path, NeuralKernelChoice::describe()
+    std::string query_shader;      // shader of the batched query pass
+    uint32_t lod_primary = 0, lod_secondary = 0, lod_count = 1; // N-BVH cuts (0 = finest) of the model
+    uint32_t leaf_budget = 0;      // leaves queried per ray at most (--neural-max-leaves)
+    uint32_t leaves_per_round = 0; // leaves a ray queues per round
+    uint32_t batched_rounds = 0;   // rounds through the batched query pass before neural_tail
+    uint32_t instances = 0, assets = 0;
+};
+
+// For a hybrid render (neural.model set, not classical): validates the options and builds the
+// renderer's NeuralStage on `ctx` as WavefrontRenderer does (kernel choice for the device, LoD clamping,
+// rounds), so --explain prints what the render will run; throws the errors the render would. nullopt
+// without a hybrid render (`ctx` may then be null).
+std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene, const NeuralRenderOptions& neural);
 
 // Specialization constants (ids NB_SC_* in shaders/shared/scene_gpu.h).
 std::vector<vk::SpecConstant> specialization(const SceneFeatures& features);
 
 // The passes that one sample wave runs, in order (file names under shaders/), e.g.
-// camera_rays, [queue_args, traverse, shade, (queue_args, shadow)] x max_depth, accumulate; resolve.
-std::vector<std::string> pass_list(const SceneFeatures& features);
+// camera_rays, [queue_args, traverse, shade, (queue_args, shadow)] x max_depth, accumulate; resolve;
+// one bounce listed. Hybrid renders (`neural`) traverse through the neural rounds (neural_stage.h).
+std::vector<std::string> pass_list(const SceneFeatures& features, const NeuralPlan* neural = nullptr);
 
-// Multi-line description for `nbvh render --explain`.
-std::string explain(const SceneFeatures& features, uint32_t max_depth);
+// Multi-line description for `nbvh render --explain`: the features, the neural stage, the passes.
+std::string explain(const SceneFeatures& features, uint32_t max_depth, const NeuralPlan* neural = nullptr);
 
 } // namespace nbvh::render

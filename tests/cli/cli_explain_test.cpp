@@ -1,0 +1,79 @@
+// `nbvh render --explain` prints the render it would run (issue 12, label lavapipe): for a hybrid render
+// (--model) the neural stage built as the renderer builds it on the device (MLP path, LoD, leaves per
+// round) and the neural passes; without a model or with --classical, the classical passes only.
+#include <gtest/gtest.h>
+
+#include "tests/cli/run_nbvh.h"
+#include "tests/support/test_support.h"
+
+namespace {
+namespace fs = std::filesystem;
+using nbvh::test::check_clean_error;
+using nbvh::test::run_nbvh;
+
+// A tiny 2-LoD model of the default scene's rope knot (about a second on the CPU backend), trained once.
+const fs::path& tiny_model() {
+    static const fs::path model = [] {
+        const fs::path m = nbvh::test::temp_dir("cli_explain_model") / "tiny.nbvh";
+        const auto r =
+            run_nbvh({"train", "default", "--backend", "cpu", "--steps", "20", "--batch", "256", "--nodes",
+                      "63", "--hash-log2", "12", "--lods", "2", "--threads", "2", "--out", m.string()},
+                     120.0);
+        EXPECT_EQ(r.exit_code, 0) << r.describe();
+        return m;
+    }();
+    return model;
+}
+
+std::vector<std::string> explain(std::vector<std::string> extra) {
+    std::vector<std::string> a = {"render", "default", "--device", "cpu", "--explain"};
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+}
+
+bool has(const std::string& text, const std::string& word) { return text.find(word) != std::string::npos; }
+
+TEST(CliExplain, HybridRenderListsTheNeuralPasses) {
+    const auto r =
+        run_nbvh(explain({"--model", tiny_model().string(), "--lod", "1", "--secondary-lod", "0"}), 60.0);
+    ASSERT_EQ(r.exit_code, 0) << r.describe();
+    const std::string& o = r.out;
+    EXPECT_TRUE(has(o, "neural assets   yes")) << o;
+    // lavapipe has no cooperative matrices: auto picks the scalar path, as the renderer would.
+    EXPECT_TRUE(has(o, "MLP path        scalar")) << o;
+    EXPECT_TRUE(has(o, "camera rays 1, after the first hit 0 (the model has 2")) << o;
+    EXPECT_TRUE(has(o, "at most 8, 4 queued per round: 2 batched rounds")) << o;
+    for (const char* pass :
+         {"passes/neural_traverse.comp", "passes/neural_args.comp", "passes/neural_query_scalar.comp",
+          "passes/neural_tail.comp", "passes/neural_shadow.comp", "passes/shade.comp"})
+        EXPECT_TRUE(has(o, pass)) << pass << "\n" << o;
+    EXPECT_FALSE(has(o, "passes/traverse.comp")) << "hybrid renders traverse through the neural rounds\n"
+                                                 << o;
+}
+
+TEST(CliExplain, LeavesPerRoundComeFromTheRenderersStage) {
+    // The benchmark override of leaves per round is read where the renderer reads it.
+    setenv("NBVH_NEURAL_LEAVES_PER_ROUND", "2", 1);
+    const auto r = run_nbvh(explain({"--model", tiny_model().string()}), 60.0);
+    unsetenv("NBVH_NEURAL_LEAVES_PER_ROUND");
+    ASSERT_EQ(r.exit_code, 0) << r.describe();
+    EXPECT_TRUE(has(r.out, "at most 8, 2 queued per round: 4 batched rounds")) << r.out;
+}
+
+TEST(CliExplain, ClassicalRendersHaveNoNeuralPasses) {
+    for (const auto& extra : {std::vector<std::string>{},
+                              std::vector<std::string>{"--model", tiny_model().string(), "--classical"}}) {
+        const auto r = run_nbvh(explain(extra), 60.0);
+        ASSERT_EQ(r.exit_code, 0) << r.describe();
+        EXPECT_TRUE(has(r.out, "neural assets   no")) << r.out;
+        EXPECT_TRUE(has(r.out, "passes/traverse.comp")) << r.out;
+        EXPECT_FALSE(has(r.out, "neural_")) << r.out;
+    }
+}
+
+TEST(CliExplain, ForcedCoopmatOnLavapipeIsTheRendersError) {
+    const auto r = run_nbvh(explain({"--model", tiny_model().string(), "--neural-path", "coopmat"}), 60.0);
+    EXPECT_EQ(check_clean_error(r, {"coopmat"}, false), "") << r.describe();
+}
+
+} // namespace
