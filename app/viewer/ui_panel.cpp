@@ -62,10 +62,14 @@ PanelActions draw_panel(ViewSettings& s, const PanelInfo& info) {
         ImGui::SliderInt("secondary LoD", &s.secondary_lod, -1, lods - 1, s.secondary_lod < 0 ? "same" : "%d");
         if (ImGui::IsItemDeactivatedAfterEdit()) act.rebuild = true;
         ImGui::EndDisabled();
+        // Neural surfaces are shaded with their asset's glTF material unless overridden here.
+        if (ImGui::Checkbox("override material", &s.override_material)) act.rebuild = true;
+        ImGui::BeginDisabled(!s.override_material);
         ImGui::SliderFloat("roughness", &s.roughness, 0.0f, 1.0f);
         if (ImGui::IsItemDeactivatedAfterEdit()) act.rebuild = true;
         ImGui::SliderFloat("metallic", &s.metallic, 0.0f, 1.0f);
         if (ImGui::IsItemDeactivatedAfterEdit()) act.rebuild = true;
+        ImGui::EndDisabled();
         if (s.neural && !info.neural_path.empty())
             ImGui::Text("%s, %.2f queries/ray", info.neural_path.c_str(), info.neural_queries_per_ray);
         if (ImGui::TreeNode("nodes per LoD")) {

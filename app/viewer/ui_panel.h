@@ -19,6 +19,7 @@ struct ViewSettings {
     bool neural = true;
     int lod = 0;               // primary-ray LoD (0 = finest cut)
     int secondary_lod = -1;    // after the first hit; -1: same as lod
+    bool override_material = false; // else the assets' glTF materials
     float roughness = 0.5f, metallic = 0.0f;
 };
 

@@ -209,8 +209,8 @@ void run_viewer(const ViewerArgs& a) {
                     o.neural.classical = !s.neural;
                     o.neural.lod = uint32_t(s.lod);
                     o.neural.secondary_lod = s.secondary_lod;
-                    o.neural.roughness = s.roughness;
-                    o.neural.metallic = s.metallic;
+                    o.neural.roughness = s.override_material ? s.roughness : -1.0f;
+                    o.neural.metallic = s.override_material ? s.metallic : -1.0f;
                 }
                 try {
                     ctx.wait_idle();

@@ -263,6 +263,45 @@ TEST(ModelFile, ChessReferenceIsTheOfficialFormat) {
     EXPECT_EQ(tree.max_depth(), 21u);
 }
 
+// A version-1 file (before the asset table: ASST = encoding box + one asset name) still loads, as one
+// asset with root 0, identity placement and unknown fingerprints.
+TEST(ModelFile, Version1FilesStillLoad) {
+    const std::vector<uint8_t> v2 = serialize_model(make_tiny_model());
+    std::vector<std::vector<uint8_t>> payloads;
+    std::vector<std::string> ids;
+    for (const auto& sec : test::section_locations(v2)) {
+        ids.push_back(sec.id);
+        std::vector<uint8_t> p(v2.begin() + long(sec.offset), v2.begin() + long(sec.offset + sec.size));
+        if (sec.id == "ASST") {
+            p.resize(24); // the encoding box
+            const std::string name = "old_asset";
+            const uint32_t len = uint32_t(name.size());
+            p.insert(p.end(), reinterpret_cast<const uint8_t*>(&len), reinterpret_cast<const uint8_t*>(&len) + 4);
+            p.insert(p.end(), name.begin(), name.end());
+        }
+        payloads.push_back(std::move(p));
+    }
+    std::vector<uint8_t> v1(v2.begin(), v2.begin() + long(32 + 32 * ids.size()));
+    poke<uint32_t>(v1, 4, 1);
+    for (size_t k = 0; k < ids.size(); ++k) {
+        v1.resize((v1.size() + 7) & ~size_t(7), 0);
+        poke<uint64_t>(v1, 32 + 32 * k + 8, v1.size());
+        poke<uint64_t>(v1, 32 + 32 * k + 16, payloads[k].size());
+        v1.insert(v1.end(), payloads[k].begin(), payloads[k].end());
+    }
+    v1.resize((v1.size() + 7) & ~size_t(7), 0);
+    poke<uint64_t>(v1, 16, v1.size());
+    refresh_checksums(v1);
+    const NeuralModel m = parse_model(v1, "old.nbvh");
+    ASSERT_EQ(m.assets.size(), 1u);
+    EXPECT_EQ(m.assets[0].name, "old_asset");
+    EXPECT_EQ(m.assets[0].material, "");
+    EXPECT_EQ(m.assets[0].root, 0u);
+    EXPECT_EQ(m.assets[0].scale, 1.0f);
+    EXPECT_EQ(m.assets[0].geometry_hash, 0u);
+    EXPECT_EQ(m.nodes.size(), make_tiny_model().nodes.size());
+}
+
 // Several assets: their subtrees must be disjoint (a root inside another asset's subtree, or shared, is
 // refused when saving as when loading), names unique; a valid table round-trips.
 TEST(ModelFile, AssetTable) {
