@@ -129,6 +129,28 @@ def neural_scene():
                    {"name": "floor", "primitives": [{"attributes": {"POSITION": pos}, "indices": strip, "mode": 5}]}]})
 
 
+def skin_morph():
+    # A quad skinned to two joints (the second rotated), with a morph target at default weights.
+    b = Builder()
+    pos = b.vec3(QUAD)
+    joints = b.add("B", [0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0], 5121, "VEC4", 34962, False, 4)
+    weights = b.add("f", [1, 0, 0, 0, 0.5, 0.5, 0, 0, 0, 1, 0, 0, 1, 0, 0, 0], 5126, "VEC4", 34962, False, 4)
+    identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
+    ibm = b.add("f", identity + identity[:12] + [-1, 0, 0, 1], 5126, "MAT4", None, False, 16)
+    delta = b.vec3([0, 0, 0.5] * 4)
+    idx = b.add("H", [0, 1, 2, 0, 2, 3], 5123, "SCALAR", 34963)
+    return b.doc({
+        "scene": 0, "scenes": [{"nodes": [0, 1, 3]}],
+        "nodes": [{"name": "skinned", "mesh": 0, "skin": 0}, {"name": "root", "children": [2]},
+                  {"name": "bone", "translation": [1, 0, 0], "rotation": [0, 0, 0.3826834, 0.9238795]},
+                  {"name": "morphed", "mesh": 1, "weights": [0.75], "translation": [0, 2, 0]}],
+        "skins": [{"joints": [1, 2], "inverseBindMatrices": ibm, "skeleton": 1}],
+        "meshes": [{"name": "skin", "primitives": [{"attributes": {"POSITION": pos, "JOINTS_0": joints,
+                                                                   "WEIGHTS_0": weights}, "indices": idx}]},
+                   {"name": "morph", "weights": [0.5], "primitives": [{"attributes": {"POSITION": pos}, "indices": idx,
+                                                                       "targets": [{"POSITION": delta}]}]}]})
+
+
 def glb(doc_builder):
     d = doc_builder()
     raw = base64.b64decode(d["buffers"][0]["uri"].split(",", 1)[1])
@@ -146,6 +168,7 @@ def main():
              "valid_material_quad.gltf": json.dumps(material_quad(), indent=1).encode(),
              "valid_textured_quad.gltf": json.dumps(textured(), indent=1).encode(),
              "valid_neural_scene.gltf": json.dumps(neural_scene(), indent=1).encode(),
+             "valid_skin_morph.gltf": json.dumps(skin_morph(), indent=1).encode(),
              "valid_material_quad.glb": glb(material_quad)}
     for name, data in files.items():
         with open(os.path.join(OUT, name), "wb") as f:
