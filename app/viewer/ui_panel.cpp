@@ -31,6 +31,7 @@ PanelActions draw_panel(ViewSettings& s, const PanelInfo& info) {
     ImGui::TextDisabled("%s", info.device.c_str());
     ImGui::Text("frame %.1f ms  |  %u spp", info.frame_ms, info.samples);
     ImGui::Text("%.3g rays/s (GPU)", info.rays_per_second);
+    ImGui::Text("renderer builds %u, live setting changes %u", info.renderer_builds, info.live_updates);
     if (ImGui::Button("reset camera (R)")) act.reset_camera = true;
     ImGui::SameLine();
     if (ImGui::Button("restart")) act.reset_accumulation = true;

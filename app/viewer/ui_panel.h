@@ -29,6 +29,8 @@ struct PanelInfo {
     uint32_t samples = 0;          // in the film
     double frame_ms = 0.0;         // wall time of the last frame's path tracing
     double rays_per_second = 0.0;  // last frame, GPU time
+    uint32_t renderer_builds = 0;  // renderers built (scene upload, pipelines)
+    uint32_t live_updates = 0;     // setting changes applied as uploads (no rebuild)
     bool has_model = false;
     std::vector<uint32_t> lod_node_counts; // N-BVH nodes per LoD (index = LoD)
     std::string neural_path;       // MLP kernel in use (hybrid only)

@@ -214,8 +214,15 @@ void run_viewer(const ViewerArgs& a) {
                 }
                 try {
                     ctx.wait_idle();
-                    auto next = std::make_unique<render::WavefrontRenderer>(ctx, scene, accel, env, cam.camera(), o);
-                    renderer = std::move(next);
+                    // Settings are uploads (WavefrontRenderer::apply); a new renderer only for what needs
+                    // new buffers or pipelines (window size, leaves per round, overrides of a classical view).
+                    if (renderer && renderer->apply(o)) {
+                        info.live_updates++;
+                    } else {
+                        auto next = std::make_unique<render::WavefrontRenderer>(ctx, scene, accel, env, cam.camera(), o);
+                        renderer = std::move(next);
+                        info.renderer_builds++;
+                    }
                     info.status.clear();
                 } catch (const Error& e) {
                     if (!renderer) throw; // nothing to fall back to

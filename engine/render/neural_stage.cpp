@@ -114,16 +114,7 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
                          const NeuralRenderOptions& o, uint32_t ray_capacity)
     : ctx_(ctx), model_(ctx, model), kernel_(choose_neural_kernel(ctx.features(), o.path)),
       rounds_(o.max_rounds), capacity_(ray_capacity) {
-    params_.leaves_per_round = effective_leaves_per_round(o);
-    // Every round queues leaves_per_round leaves per ray still going, or finishes it (fewer leaves left
-    // in front of its hit): after ceil(max_rounds / leaves_per_round) rounds no ray is left.
-    const uint32_t needed = (o.max_rounds + params_.leaves_per_round - 1) / params_.leaves_per_round;
-    batched_ = std::min(needed, o.batched_rounds);
-    params_.box = model_.box();
-    params_.lod_primary = std::min(o.lod, model_.lod_count() - 1);
-    params_.lod_secondary = std::min(o.secondary_lod < 0 ? o.lod : uint32_t(o.secondary_lod), model_.lod_count() - 1);
-    params_.roughness = o.roughness < 0.0f ? -1.0f : o.roughness;
-    params_.metallic = o.metallic < 0.0f ? -1.0f : o.metallic;
+    set_params(o);
     // The asset table: each asset's subtree root per LoD (LoDs past the model's repeat its coarsest) and
     // the material of the scene mesh it answers (one material per asset after bind_model_to_scene).
     assets_.resize(model.assets.size());
@@ -143,8 +134,27 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
             }
         if (g.material >= std::max<size_t>(scene.materials.size(), 1)) g.material = 0;
     }
+}
+
+void NeuralStage::set_params(const NeuralRenderOptions& o) {
+    rounds_ = o.max_rounds;
+    params_.leaves_per_round = effective_leaves_per_round(o);
+    // Every round queues leaves_per_round leaves per ray still going, or finishes it (fewer leaves left
+    // in front of its hit): after ceil(max_rounds / leaves_per_round) rounds no ray is left.
+    const uint32_t needed = (o.max_rounds + params_.leaves_per_round - 1) / params_.leaves_per_round;
+    batched_ = std::min(needed, o.batched_rounds);
+    params_.box = model_.box();
+    params_.lod_primary = std::min(o.lod, model_.lod_count() - 1);
+    params_.lod_secondary = std::min(o.secondary_lod < 0 ? o.lod : uint32_t(o.secondary_lod), model_.lod_count() - 1);
+    params_.roughness = o.roughness < 0.0f ? -1.0f : o.roughness;
+    params_.metallic = o.metallic < 0.0f ? -1.0f : o.metallic;
     params_.threshold = o.threshold;
     params_.max_rounds = o.max_rounds;
+}
+
+void NeuralStage::update(const NeuralRenderOptions& o, vk::Buffer& params_buffer) {
+    set_params(o);
+    params_buffer.upload(&params_, sizeof(params_));
 }
 
 const char* NeuralStage::query_shader() const {

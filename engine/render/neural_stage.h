@@ -75,6 +75,10 @@ public:
     NeuralStage(const vk::Context& ctx, const NeuralModel& model, const Scene& scene, const NeuralRenderOptions& options,
                 uint32_t ray_capacity);
 
+    // New per-render neural settings (LoDs, overrides, leaf budget, batched rounds, threshold) written
+    // into the params buffer. Leaves per round and the model cannot change here.
+    void update(const NeuralRenderOptions& options, vk::Buffer& params_buffer);
+
     // Moves the neural buffers into `buffers` (indexed by binding, resized to NB_NEURAL_BINDING_END):
     // NB_BIND_NEURAL_*, NB_BIND_NBVH_*, and the pending-leaf queue at NB_BIND_PENDING_LEAVES.
     void install(std::vector<vk::Buffer>& buffers);
@@ -89,6 +93,8 @@ public:
     const GpuNeuralParams& params() const { return params_; }
 
 private:
+    void set_params(const NeuralRenderOptions& options);
+
     const vk::Context& ctx_;
     NeuralModelGpu model_;
     NeuralKernelChoice kernel_;

@@ -46,7 +46,7 @@ void set_camera_params(GpuFrameParams& p, const Camera& camera, float aspect) {
 WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene, const SceneAccel& accel,
                                      const Environment& environment, const Camera& camera,
                                      const RenderOptions& options)
-    : ctx_(ctx), options_(options) {
+    : ctx_(ctx), scene_(&scene), options_(options) {
     if (options_.width == 0 || options_.height == 0 || options_.width > 16384 || options_.height > 16384)
         throw Error(strfmt("image size %ux%u is out of range (1..16384 per side)", options_.width, options_.height));
     if (options_.spp == 0) throw Error("--spp must be at least 1");
@@ -61,7 +61,9 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     uint64_t cap = std::min<uint64_t>(pixels, std::max<uint32_t>(options_.max_wave_pixels, 64));
     cap = std::min<uint64_t>(cap, range / (2ull * NB_RAY_WORDS * 4ull));
     // Hybrid renders keep a neural state per path and per shadow ray in one binding (neural_stage.h).
-    if (options_.neural.model && !options_.neural.classical) {
+    // With a model the neural state is allocated also for a classical start: the renderer switches
+    // between hybrid and classical without a rebuild (apply()).
+    if (options_.neural.model) {
         cap = std::min<uint64_t>(cap, range / (2ull * sizeof(GpuNeuralRayState)));
         const uint64_t k = effective_leaves_per_round(options_.neural);
         cap = std::min<uint64_t>(cap, range / (2ull * k * sizeof(GpuPendingLeaf)));
@@ -79,10 +81,15 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     // (classical reference); without either they render as plain triangles.
     const NeuralRenderOptions& nopt = options_.neural;
     if (nopt.model || nopt.classical) validate(nopt, scene);
-    if (nopt.classical && (nopt.roughness >= 0.0f || nopt.metallic >= 0.0f))
+    if (nopt.classical && (nopt.roughness >= 0.0f || nopt.metallic >= 0.0f)) {
         apply_classical_materials(scene, data_, nopt.roughness, nopt.metallic);
-    const bool hybrid = nopt.model && !nopt.classical;
-    if (hybrid) features_.neural = mark_neural_instances(scene, accel, *nopt.model, data_) > 0;
+        classical_overrides_ = true;
+    }
+    // The neural instance records (asset, atlas transforms) beside the classical ones: hybrid and
+    // classical renders of one scene differ only in which array is bound.
+    std::vector<GpuInstance> classical_instances = data_.instances;
+    if (nopt.model) features_.neural = mark_neural_instances(scene, accel, *nopt.model, data_) > 0;
+    hybrid_ = features_.neural && !nopt.classical;
     if (features_.emission && data_.lights.size() == 1 && data_.light_total_power <= 0.0f) features_.emission = false;
 
     // Per-render parameters.
@@ -113,6 +120,10 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     buffers_[NB_BIND_TLAS_NODES] = upload(ctx_, data_.tlas_nodes, "tlas nodes");
     buffers_[NB_BIND_BLAS_NODES] = upload(ctx_, data_.blas_nodes, "blas nodes");
     buffers_[NB_BIND_INSTANCES] = upload(ctx_, data_.instances, "instances");
+    if (features_.neural) {
+        other_instances_ = upload(ctx_, classical_instances, "classical instances");
+        if (!hybrid_) std::swap(buffers_[NB_BIND_INSTANCES], other_instances_);
+    }
     buffers_[NB_BIND_TRIANGLES] = upload(ctx_, data_.triangles, "triangles");
     buffers_[NB_BIND_VERTICES] = upload(ctx_, data_.vertices, "vertices");
     buffers_[NB_BIND_MATERIALS] = upload(ctx_, data_.materials, "materials");
@@ -162,8 +173,49 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
         for (uint32_t b = 0; b < NB_NEURAL_BINDING_END; ++b) set.bind(b, buffers_[b]);
         sets_.push_back(std::move(set));
     }
-    timer_ = vk::GpuTimer(ctx_, 64 + (8 + (neural_ ? 6 * neural_->batched_rounds() + 8 : 0)) * options_.max_depth);
+    make_timer();
     cmd_ = vk::CommandBuffer(ctx_, "wavefront");
+}
+
+void WavefrontRenderer::make_timer() {
+    timer_ = vk::GpuTimer(ctx_, 64 + (8 + (neural_ ? 6 * neural_->batched_rounds() + 8 : 0)) * options_.max_depth);
+}
+
+bool WavefrontRenderer::apply(const RenderOptions& o) {
+    const RenderOptions& c = options_;
+    const NeuralRenderOptions &n = o.neural, &cn = c.neural;
+    // What needs new buffers or pipelines: the film size and waves, another model, the MLP path, the
+    // pending-queue size, material overrides baked into a classical reference's triangles.
+    const bool overrides = n.roughness >= 0.0f || n.metallic >= 0.0f;
+    if (o.width != c.width || o.height != c.height || o.max_wave_pixels != c.max_wave_pixels || n.model != cn.model ||
+        n.path != cn.path || (n.model && effective_leaves_per_round(n) != neural_->leaves_per_round()) ||
+        (n.classical && overrides) != classical_overrides_ || (n.model && !features_.neural && !n.classical))
+        return false;
+    if (n.model) validate(n, *scene_);
+    ++live_updates_;
+    options_.max_depth = o.max_depth;
+    options_.rr_start_depth = o.rr_start_depth;
+    options_.seed = o.seed;
+    options_.spp = o.spp;
+    params_.max_depth = o.max_depth;
+    params_.rr_start_depth = o.rr_start_depth;
+    params_.seed = o.seed;
+    params_.spp = o.spp;
+    buffers_[NB_BIND_PARAMS].upload(&params_, sizeof(params_));
+    if (neural_) {
+        options_.neural = n;
+        neural_->update(n, buffers_[NB_BIND_NEURAL_PARAMS]);
+        const bool hybrid = !n.classical;
+        if (hybrid != hybrid_) {
+            hybrid_ = hybrid;
+            std::swap(buffers_[NB_BIND_INSTANCES], other_instances_);
+            for (vk::DescriptorSet& set : sets_)
+                if (set.handle() != VK_NULL_HANDLE) set.bind(NB_BIND_INSTANCES, buffers_[NB_BIND_INSTANCES]);
+        }
+    }
+    make_timer();
+    accumulated_ = 0;
+    return true;
 }
 
 GpuPassConstants WavefrontRenderer::constants(uint32_t queue, uint32_t depth, uint32_t sample, uint32_t offset,
@@ -224,7 +276,7 @@ void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, uint32_t samp
     uint32_t q = 0;
     for (uint32_t depth = 0; depth < options_.max_depth; ++depth) {
         record_pass(cmd, QUEUE_ARGS, constants(q, depth, sample, offset, count, NB_ARGS_MODE_RAYS), Dispatch::single);
-        if (neural_) {
+        if (hybrid_) {
             // Closest hits through triangles and neural leaves: queue a pair per ray, query, resume.
             record_neural_rounds(cmd, NEURAL_TRAVERSE, q, depth, sample, offset, count);
             record_pass(cmd, NEURAL_TRAVERSE, constants(q, depth, sample, offset, count, 2), Dispatch::indirect_rays);
@@ -235,8 +287,9 @@ void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, uint32_t samp
         if (features_.has_lights()) {
             record_pass(cmd, QUEUE_ARGS, constants(q, depth, sample, offset, count, NB_ARGS_MODE_SHADOW),
                         Dispatch::single);
-            if (neural_) record_neural_rounds(cmd, NEURAL_SHADOW, q, depth, sample, offset, count);
-            record_pass(cmd, SHADOW, constants(q, depth, sample, offset, count, 0), Dispatch::indirect_shadow);
+            if (hybrid_) record_neural_rounds(cmd, NEURAL_SHADOW, q, depth, sample, offset, count);
+            record_pass(cmd, SHADOW, constants(q, depth, sample, offset, count, hybrid_ ? NB_SHADOW_MODE_HYBRID : 0u),
+                        Dispatch::indirect_shadow);
         }
         q = 1 - q;
     }
@@ -342,7 +395,7 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
     s.rays_secondary = totals[1];
     s.rays_shadow = totals[2];
     s.nonfinite_samples = totals[3];
-    if (neural_) {
+    if (hybrid_) {
         s.neural_path = neural_->kernel().describe();
         s.neural_queries = totals[4];
         s.neural_rounds = totals[5];
@@ -381,7 +434,7 @@ std::vector<TraceHit> WavefrontRenderer::trace(const std::vector<glm::vec3>& ori
         cmd_.begin();
         if (timer_.available()) timer_.reset(cmd_.handle());
         record_pass(cmd_, QUEUE_ARGS, constants(0, 0, 0, 0, n, NB_ARGS_MODE_RAYS), Dispatch::single);
-        if (neural_) { // as record_sample_wave at depth 0
+        if (hybrid_) { // as record_sample_wave at depth 0
             record_neural_rounds(cmd_, NEURAL_TRAVERSE, 0, 0, 0, 0, n);
             record_pass(cmd_, NEURAL_TRAVERSE, constants(0, 0, 0, 0, n, 2), Dispatch::indirect_rays);
         } else {
@@ -391,7 +444,7 @@ std::vector<TraceHit> WavefrontRenderer::trace(const std::vector<glm::vec3>& ori
         cmd_.submit_and_wait();
         const std::vector<uint32_t> hits = buffers_[NB_BIND_HITS].download<uint32_t>(size_t(capacity_) * NB_HIT_WORDS);
         std::vector<GpuNeuralRayState> states;
-        if (neural_) states = buffers_[NB_BIND_NEURAL_STATE].download<GpuNeuralRayState>(n);
+        if (hybrid_) states = buffers_[NB_BIND_NEURAL_STATE].download<GpuNeuralRayState>(n);
         for (uint32_t i = 0; i < n; ++i) {
             TraceHit h;
             const uint32_t inst = hits[nb_hit_word(NB_HIT_INSTANCE, capacity_, i, 1)];
@@ -399,7 +452,7 @@ std::vector<TraceHit> WavefrontRenderer::trace(const std::vector<glm::vec3>& ori
                 h.t = uintBitsToFloat(hits[nb_hit_word(NB_HIT_T, capacity_, i, 1)]);
                 h.instance = data_.instance_to_scene[inst];
                 const uint32_t tri = hits[nb_hit_word(NB_HIT_TRIANGLE, capacity_, i, 1)];
-                if (neural_ && tri == NB_NEURAL_TRIANGLE) {
+                if (hybrid_ && tri == NB_NEURAL_TRIANGLE) {
                     h.neural = true;
                     h.normal = states[i].normal;
                     out.push_back(h);

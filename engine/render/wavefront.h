@@ -95,6 +95,15 @@ public:
     // With read_back false the mean stays on the GPU (result.image is empty): output() holds it, for a
     // display pass (the viewer), and read_output() fetches it later.
     void set_camera(const Camera& camera);
+    // Settings without a rebuild (the viewer's sliders): path depth, Russian roulette, seed, spp, and
+    // with a model: hybrid <-> classical, LoDs, leaf budget, batched rounds, visibility threshold and the
+    // material overrides of neural hits are uploads (params buffers, the bound instance array). Returns
+    // false, changing nothing, when `options` differ in what needs new buffers or pipelines (size,
+    // waves, model, MLP path, leaves per round, overrides baked into a classical reference): build a
+    // new renderer then. Clears the film. Throws nbvh::Error on invalid neural options.
+    bool apply(const RenderOptions& options);
+    uint64_t live_updates() const { return live_updates_; } // successful apply() calls
+    bool hybrid() const { return hybrid_; }
     RenderResult render_progressive(uint32_t samples = 1, bool read_back = true);
     uint32_t accumulated_samples() const { return accumulated_; }
     // Linear RGBA32F mean radiance of the last render, width*height pixels, rows top to bottom.
@@ -120,7 +129,10 @@ private:
     // Samples [first, first + count) into the film (cleared when first == 0), then resolve + read back.
     RenderResult render_samples(uint32_t first, uint32_t count, bool read_back = true);
 
+    void make_timer();
+
     const vk::Context& ctx_;
+    const Scene* scene_ = nullptr; // the caller's, outlives the renderer (validation in apply())
     RenderOptions options_;
     SceneFeatures features_;
     GpuSceneData data_;
@@ -131,7 +143,11 @@ private:
     std::vector<vk::Buffer> buffers_;          // indexed by NB_BIND_*
     std::vector<vk::ComputePipeline> pipelines_; // indexed by Pass
     std::vector<vk::DescriptorSet> sets_;
-    std::unique_ptr<NeuralStage> neural_; // hybrid render only
+    std::unique_ptr<NeuralStage> neural_; // renders with a model (hybrid or its classical reference)
+    bool hybrid_ = false;                 // neural instances through the N-BVH (else their triangles)
+    bool classical_overrides_ = false;    // the classical reference's triangles carry material overrides
+    vk::Buffer other_instances_;          // the instance array not bound (classical <-> hybrid)
+    uint64_t live_updates_ = 0;
     vk::GpuTimer timer_;
     vk::CommandBuffer cmd_;
 };

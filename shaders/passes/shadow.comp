@@ -15,8 +15,9 @@ void main() {
     uint pixel = shadow_load1(NB_SHADOW_PIXEL, i);
     g_alpha_seed = nb_pcg_hash(pixel ^ (pc.depth << 24u) ^ pc.sample_index);
     bool occluded;
-    if (NB_HAS_NEURAL) {
-        // Hybrid render: passes/neural_shadow.comp decided (triangles and neural leaves).
+    if (NB_HAS_NEURAL && (pc.mode & NB_SHADOW_MODE_HYBRID) != 0u) {
+        // Hybrid render: passes/neural_shadow.comp decided (triangles and neural leaves). A renderer
+        // with a model switched to its classical reference traces here (engine/render/wavefront.h apply).
         occluded = neural_state[ray_capacity() + i].best_t < NB_INF;
     } else {
         nb_trace(org, dir, 0.0f, tmax, true);

@@ -94,6 +94,8 @@ struct GpuQueueCounters {
     uint nonfinite_samples;          // path samples dropped by accumulate because they were NaN/Inf
 };
 NB_STATIC_ASSERT(sizeof(GpuQueueCounters) == 68, "GpuQueueCounters layout");
+// shadow.comp: the occlusion was decided by passes/neural_shadow.comp (hybrid renders).
+#define NB_SHADOW_MODE_HYBRID 1u
 #define NB_COUNTERS_RAY_DISPATCH_OFFSET 0u
 #define NB_COUNTERS_SHADOW_DISPATCH_OFFSET 12u
 #define NB_COUNTERS_PENDING_DISPATCH_OFFSET 24u
@@ -108,7 +110,7 @@ struct GpuPassConstants {
     uint sample_index;  // sample of the pixel (0 .. spp-1)
     uint pixel_offset;  // first pixel of the current wave
     uint pixel_count;   // pixels in the current wave
-    uint mode;          // pass-specific (NB_ARGS_MODE_*)
+    uint mode;          // pass-specific (NB_ARGS_MODE_*, NB_SHADOW_MODE_*)
 };
 NB_STATIC_ASSERT(sizeof(GpuPassConstants) == 24, "GpuPassConstants layout");
 

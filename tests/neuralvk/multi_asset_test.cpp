@@ -263,3 +263,55 @@ TEST(MultiAsset, AModelForAnotherSceneIsRefusedNamingTheAsset) {
     EXPECT_EQ(neural, 6u); // ball x2 parts, 3 bricks, pillar
     EXPECT_EQ(asset_of.size(), ok.meshes.size());
 }
+
+// The renderer's live settings (the viewer's sliders): hybrid <-> classical, LoD, depth and overrides
+// are uploads. A renderer switched by apply() renders exactly what a fresh renderer with those settings
+// renders (same seed); size changes are refused (a rebuild).
+TEST(MultiAsset, SettingsApplyWithoutRebuildMatchFreshRenderers) {
+    const Trained& t = trained();
+    Scene scene = make_scene();
+    bind_model_to_scene(scene, t.model, "m.nbvh");
+    vk::ContextOptions co;
+    co.device = vk::DeviceChoice::cpu;
+    co.validation = true;
+    vk::Context ctx(co);
+    const SceneAccel accel = build_scene_accel(scene);
+    RenderOptions o;
+    o.width = o.height = 48;
+    o.spp = 2;
+    o.max_depth = 3;
+    o.seed = 9;
+    o.neural.path = NeuralPath::scalar;
+    o.neural.model = &t.model;
+    auto fresh = [&](const RenderOptions& opt) {
+        WavefrontRenderer r(ctx, scene, accel, default_sky(), scene.camera, opt);
+        return r.render().image;
+    };
+    RenderOptions classical = o;
+    classical.neural.classical = true;
+    RenderOptions deeper = o;
+    deeper.max_depth = 2;
+    deeper.neural.roughness = 0.2f;
+    deeper.neural.max_rounds = 3;
+
+    WavefrontRenderer live(ctx, scene, accel, default_sky(), scene.camera, classical);
+    EXPECT_FALSE(live.hybrid());
+    const Image c0 = live.render().image;
+    ASSERT_TRUE(live.apply(o));
+    EXPECT_TRUE(live.hybrid());
+    const Image h = live.render().image;
+    ASSERT_TRUE(live.apply(deeper));
+    const Image d = live.render().image;
+    ASSERT_TRUE(live.apply(classical));
+    const Image c1 = live.render().image;
+    EXPECT_EQ(live.live_updates(), 3u);
+    EXPECT_EQ(h.data, fresh(o).data);
+    EXPECT_EQ(d.data, fresh(deeper).data);
+    EXPECT_EQ(c0.data, c1.data);
+    EXPECT_NE(h.data, c0.data); // the hybrid image is not the classical one
+    RenderOptions bigger = o;
+    bigger.width = 64;
+    EXPECT_FALSE(live.apply(bigger));
+    EXPECT_EQ(live.live_updates(), 3u);
+    EXPECT_EQ(ctx.validation_message_count(), 0);
+}
