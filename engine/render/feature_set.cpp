@@ -1,6 +1,7 @@
 #include "engine/render/feature_set.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
@@ -59,6 +60,10 @@ SceneFeatures derive_features(const Scene& scene, const Environment& environment
     if (neural.model && !neural.classical)
         for (const Instance& inst : scene.instances) f.neural = f.neural || inst.neural;
     f.environment = !environment.empty() && environment.intensity > 0.0f;
+    for (const PunctualLight& l : scene.lights) {
+        const glm::vec3 e = l.color * l.intensity;
+        if (e.x + e.y + e.z > 0.0f && std::isfinite(e.x + e.y + e.z)) f.punctual = true;
+    }
     return f;
 }
 
@@ -66,7 +71,7 @@ std::vector<vk::SpecConstant> specialization(const SceneFeatures& f) {
     return {{NB_SC_TEXTURES, f.textures ? 1u : 0u},       {NB_SC_NORMAL_MAPS, f.normal_maps ? 1u : 0u},
             {NB_SC_EMISSION, f.emission ? 1u : 0u},       {NB_SC_ENVIRONMENT, f.environment ? 1u : 0u},
             {NB_SC_ALPHA_MASK, f.alpha_mask ? 1u : 0u},   {NB_SC_TRANSMISSION, f.transmission ? 1u : 0u},
-            {NB_SC_NEURAL, f.neural ? 1u : 0u}};
+            {NB_SC_NEURAL, f.neural ? 1u : 0u},           {NB_SC_PUNCTUAL_LIGHTS, f.punctual ? 1u : 0u}};
 }
 
 std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene, const NeuralRenderOptions& o) {
@@ -136,6 +141,7 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
     s += strfmt("  emission        %s%s\n", yn(f.emission), f.emission ? "  (emissive-triangle NEE + MIS)" : "");
     s += strfmt("  environment     %s%s\n", yn(f.environment),
                 f.environment ? "  (importance-sampled environment NEE + MIS)" : "");
+    s += strfmt("  punctual lights %s%s\n", yn(f.punctual), f.punctual ? "  (KHR_lights_punctual NEE, shadow rays)" : "");
     s += strfmt("  alpha masks     %s%s\n", yn(f.alpha_mask), f.alpha_mask ? "  (alpha test in traversal)" : "");
     s += strfmt("  transmission    %s\n", yn(f.transmission));
     if (n) {

@@ -21,14 +21,15 @@ struct SceneFeatures {
     bool alpha_mask = false;    // masked or blended materials (-> alpha test in traversal)
     bool transmission = false;  // KHR_materials_transmission
     bool neural = false;        // hybrid render: neural instances answered by the model's N-BVH + MLP
+    bool punctual = false;      // KHR_lights_punctual lights of positive intensity (-> punctual NEE)
 
     // Any light that next-event estimation can sample: the shadow pass runs only then.
-    bool has_lights() const { return emission || environment; }
+    bool has_lights() const { return emission || environment || punctual; }
     bool operator==(const SceneFeatures&) const = default;
 };
 
 // Derives the features from the scene, the environment the render will use (`environment` may differ
-// from scene.environment: --env, or the default sky) and the neural options (neural: a model is given,
+// from scene.environment: --env, the default sky, or none with --env none) and the neural options (neural: a model is given,
 // not --classical, and some instance is neural). Emission counts only materials that are referenced by a
 // triangle of an instanced mesh.
 SceneFeatures derive_features(const Scene& scene, const Environment& environment,

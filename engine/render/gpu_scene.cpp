@@ -112,6 +112,58 @@ void pack_textures(const Scene& scene, const PackOptions& options, GpuSceneData&
     }
 }
 
+// Power of a punctual light for its selection probability (pbrt-v4 Light::Phi): 4 pi I for a point light,
+// 2 pi I (1 - (cos_inner + cos_outer) / 2) for a spot, pi r^2 E for a directional light over a disc of the
+// scene's radius r. Luminance of colour x intensity.
+double punctual_power(const PunctualLight& l, float scene_radius) {
+    const double lum = double(nb_luminance(l.color * l.intensity));
+    switch (l.type) {
+    case LightType::point: return 4.0 * NB_PI * lum;
+    case LightType::spot:
+        return 2.0 * NB_PI * lum * (1.0 - 0.5 * (std::cos(double(l.inner_cone)) + std::cos(double(l.outer_cone))));
+    case LightType::directional: return NB_PI * double(scene_radius) * double(scene_radius) * lum;
+    }
+    return 0.0;
+}
+
+// KHR_lights_punctual lights after the emissive triangles (GpuLight), their power cdf after the emissive cdf.
+void pack_punctual_lights(const Scene& scene, GpuSceneData& out) {
+    std::vector<double> powers;
+    double total = 0.0;
+    for (const PunctualLight& l : scene.lights) {
+        const glm::vec3 e = l.color * l.intensity;
+        const double power = punctual_power(l, 0.5f * out.scene_extent);
+        if (!(power > 0.0) || !std::isfinite(power) || !std::isfinite(e.x + e.y + e.z)) continue;
+        GpuLight g{};
+        g.kind = l.type == LightType::point ? NB_LIGHT_POINT : l.type == LightType::spot ? NB_LIGHT_SPOT
+                                                                                         : NB_LIGHT_DIRECTIONAL;
+        g.p0 = l.position;
+        g.p1 = glm::normalize(l.direction);
+        g.p2 = e;
+        g.area = l.type == LightType::directional ? 0.0f : std::max(l.range, 0.0f);
+        g.spot_scale = 0.0f;
+        g.spot_offset = 1.0f;
+        if (l.type == LightType::spot) {
+            // KHR_lights_punctual's recommended smooth cone falloff.
+            const float cos_outer = std::cos(l.outer_cone), cos_inner = std::cos(l.inner_cone);
+            g.spot_scale = 1.0f / std::max(1.0e-3f, cos_inner - cos_outer);
+            g.spot_offset = -cos_outer * g.spot_scale;
+        }
+        out.lights.push_back(g);
+        powers.push_back(power);
+        total += power;
+    }
+    out.punctual_light_count = uint32_t(powers.size());
+    const size_t base = out.light_cdf.size();
+    out.light_cdf.resize(base + powers.size() + 1, 0.0f);
+    double acc = 0.0;
+    for (size_t i = 0; i < powers.size(); ++i) {
+        acc += powers[i];
+        out.light_cdf[base + i + 1] = float(acc / total);
+    }
+    if (!powers.empty()) out.light_cdf.back() = 1.0f;
+}
+
 } // namespace
 
 GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Environment& environment,
@@ -208,7 +260,11 @@ GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Envir
                 const glm::vec3 p2 = glm::vec3(o2w * glm::vec4(out.vertices[tri.v2].position, 1.0f));
                 const float area = 0.5f * glm::length(glm::cross(p1 - p0, p2 - p0));
                 if (!(area > 0.0f) || !std::isfinite(area)) continue;
-                out.lights.push_back(GpuLight{p0, gi, p1, first + k, p2, area});
+                // Single-sided: the front face (counter-clockwise in object space) is the emitting one;
+                // a mirroring instance (det < 0) turns the world-space cross product around.
+                const float side = out.materials[tri.material].double_sided ? 0.0f
+                                   : glm::determinant(glm::mat3(o2w)) < 0.0f ? -1.0f : 1.0f;
+                out.lights.push_back(GpuLight{p0, gi, p1, first + k, p2, area, NB_LIGHT_TRIANGLE, side, 0.0f, 1.0f});
                 powers.push_back(double(lum) * area);
                 total += powers.back();
             }
@@ -222,6 +278,8 @@ GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Envir
         out.light_cdf[i + 1] = float(acc / total);
     }
     if (!powers.empty()) out.light_cdf.back() = 1.0f;
+    out.emissive_light_count = total > 0.0 ? uint32_t(out.lights.size()) : 0u;
+    pack_punctual_lights(scene, out);
     if (out.lights.empty()) out.lights.push_back(GpuLight{});
 
     out.environment = build_environment_table(environment);

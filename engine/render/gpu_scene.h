@@ -22,9 +22,11 @@ struct GpuSceneData {
     std::vector<GpuMaterial> materials;
     std::vector<GpuTextureInfo> texture_infos;
     std::vector<uint32_t> texels;         // RGBA8
-    std::vector<GpuLight> lights;         // emissive triangles, world space
-    std::vector<float> light_cdf;         // light_count + 1 entries
-    float light_total_power = 0.0f;
+    std::vector<GpuLight> lights;         // emissive triangles, then punctual lights, world space
+    std::vector<float> light_cdf;         // emissive_light_count + 1 entries, then punctual_light_count + 1
+    float light_total_power = 0.0f;       // of the emissive triangles
+    uint32_t emissive_light_count = 0;    // GpuFrameParams::light_count (0 when light_total_power is 0)
+    uint32_t punctual_light_count = 0;    // GpuFrameParams::punctual_count (lights of positive power)
     EnvironmentTable environment;
 
     // For mapping GPU results back to the scene (tests, debugging).

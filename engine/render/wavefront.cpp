@@ -90,7 +90,7 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     std::vector<GpuInstance> classical_instances = data_.instances;
     if (nopt.model) features_.neural = mark_neural_instances(scene, accel, *nopt.model, data_) > 0;
     hybrid_ = features_.neural && !nopt.classical;
-    if (features_.emission && data_.lights.size() == 1 && data_.light_total_power <= 0.0f) features_.emission = false;
+    if (features_.emission && data_.emissive_light_count == 0) features_.emission = false;
 
     // Per-render parameters.
     GpuFrameParams& p = params_;
@@ -102,7 +102,8 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     p.env_intensity = data_.environment.intensity;
     p.env_rotation = data_.environment.rotation;
     p.env_inv_mean = data_.environment.inv_mean;
-    p.light_count = data_.light_total_power > 0.0f ? uint32_t(data_.lights.size()) : 0u;
+    p.light_count = data_.emissive_light_count;
+    p.punctual_count = data_.punctual_light_count;
     p.light_total_power = data_.light_total_power;
     p.max_depth = options_.max_depth;
     p.rr_start_depth = options_.rr_start_depth;

@@ -15,6 +15,7 @@
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/scene/gltf_accessor.h"
+#include "engine/scene/gltf_lights.h"
 #include "engine/scene/gltf_material.h"
 #include "engine/scene/gltf_pose.h"
 #include "engine/scene/gltf_schema.h"
@@ -271,6 +272,7 @@ private:
     void add_node(int node_index, const glm::dmat4& world) {
         const tinygltf::Node& node = model_.nodes[size_t(node_index)];
         if (node.camera >= 0 && !scene_.has_camera) add_camera(node, world);
+        if (auto light = gltf::node_light(model_, node, node_index, world, file_)) scene_.lights.push_back(*light);
         if (node.mesh < 0) return;
         if (size_t(node.mesh) >= model_.meshes.size()) {
             log_warn("%s: node %d refers to mesh %d which does not exist; skipped", file_.c_str(), node_index, node.mesh);
@@ -518,6 +520,12 @@ private:
             how = mark_neural_by_scene();
         }
         log_info("%s; neural: %s", describe(scene_).c_str(), how.c_str());
+        if (!scene_.lights.empty()) {
+            uint32_t count[3] = {0, 0, 0};
+            for (const PunctualLight& l : scene_.lights) ++count[uint32_t(l.type)];
+            log_info("%s: %zu punctual light%s (%u point, %u spot, %u directional)", file_.c_str(), scene_.lights.size(),
+                     scene_.lights.size() == 1 ? "" : "s", count[0], count[1], count[2]);
+        }
         if (skinned_instances_ || morphed_meshes_)
             log_info("%s: %u skinned instance%s posed by the joints' node transforms, %u mesh%s morphed at the default "
                      "weights (no animation is played)", file_.c_str(), skinned_instances_,

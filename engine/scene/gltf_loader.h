@@ -3,7 +3,8 @@
 // What is loaded: the node hierarchy of the main scene (TRS or matrix; the same mesh on several nodes gives
 // several Instances of one Mesh), triangle primitives (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN; points and
 // lines are skipped with a warning), metallic-roughness materials with KHR_texture_transform,
-// KHR_materials_emissive_strength and KHR_materials_transmission, and the first glTF camera.
+// KHR_materials_emissive_strength and KHR_materials_transmission, KHR_lights_punctual lights, and the first
+// glTF camera.
 // The environment is not part of glTF: Scene::environment stays empty (see environment.h).
 //
 // Bad input (see ../shared/scenes/bad/README.md) gives either an nbvh::Error with one line naming the file and

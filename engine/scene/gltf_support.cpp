@@ -12,18 +12,18 @@
 namespace nbvh::gltf {
 namespace {
 
-// Implemented (gltf_material.cpp, gltf_accessor.cpp), or nothing to render: FB_ngon_encoding only orders
+// Implemented (gltf_material.cpp, gltf_accessor.cpp, gltf_lights.cpp), or nothing to render: FB_ngon_encoding only orders
 // a polygon's triangles, the XMP extensions carry metadata.
 const char* const SUPPORTED[] = {
     "KHR_texture_transform",   "KHR_materials_emissive_strength", "KHR_materials_transmission",
     "KHR_mesh_quantization", // integer and normalized attributes: gltf_accessor.cpp read_floats
+    "KHR_lights_punctual",   // gltf_lights.cpp; rendered by next-event estimation (engine/render)
     "FB_ngon_encoding",        "KHR_xmp_json_ld",                 "KHR_xmp",
 };
 
 // What the image loses, for the warning (unknown extensions: just "ignored").
 const char* consequence(const std::string& name) {
     static const std::map<std::string, const char*> notes = {
-        {"KHR_lights_punctual", "its lights are not rendered"},
         {"KHR_materials_pbrSpecularGlossiness", "the metallic-roughness fallback values are used"},
         {"KHR_materials_volume", "transmission is thin-walled"},
         {"KHR_materials_ior", "index of refraction 1.5"},

@@ -82,6 +82,23 @@ struct Camera {
     float yfov = 0.8f; // radians
 };
 
+// A KHR_lights_punctual light in world space. Intensity is in the extension's units: candela for point and
+// spot lights, lux for directional ones; the renderer takes 1 cd (1 lux) as 1 unit of its radiance scale
+// (as the glTF sample viewer does), so a point light of I cd gives irradiance I / d^2 at distance d (m).
+enum class LightType : uint32_t { point = 0, spot = 1, directional = 2 };
+
+struct PunctualLight {
+    std::string name;
+    LightType type = LightType::point;
+    glm::vec3 color{1.0f};             // linear RGB
+    float intensity = 1.0f;            // cd (point, spot) or lux (directional)
+    glm::vec3 position{0.0f};          // world (m); unused by directional lights
+    glm::vec3 direction{0.0f, 0.0f, -1.0f}; // world, unit: where the light shines (the node's -z); unused by point lights
+    float range = 0.0f;                // m; 0 = infinite (point and spot only)
+    float inner_cone = 0.0f;           // spot: radians, 0 <= inner < outer <= pi/2
+    float outer_cone = 0.7853982f;
+};
+
 // Equirectangular environment (linear RGB), or a constant colour when `pixels` is empty.
 struct Environment {
     uint32_t width = 0, height = 0;
@@ -101,6 +118,7 @@ struct Scene {
     Camera camera;
     bool has_camera = false;       // a glTF camera was found
     Environment environment;
+    std::vector<PunctualLight> lights; // KHR_lights_punctual, transformed by their nodes
     Aabb world_bounds() const;
 };
 

@@ -1,8 +1,9 @@
 // Pass 3: shades the closest hit of every ray in queue pc.in_queue.
 //   miss  -> environment radiance (MIS-weighted against environment NEE);
 //   hit   -> emitted radiance (MIS-weighted against emissive NEE), then, if the path may grow:
-//            next-event estimation: one light sample (environment or emissive triangle), evaluated
-//            here and appended to the shadow queue with its MIS weight (power heuristic);
+//            next-event estimation: one light sample (environment, emissive triangle or punctual light,
+//            lib/lights.glsl nb_light_strategies), evaluated here and appended to the shadow queue with its
+//            MIS weight (power heuristic; punctual lights are delta lights: weight 1, NEE only);
 //            BSDF sampling + Russian roulette: the continuation ray is appended to queue 1 - in_queue.
 // Radiance goes to sample_radiance[pixel - pixel_offset] (one path per pixel per wave: no races).
 #version 460
@@ -14,13 +15,6 @@
 #include "shared/intersect.h"
 
 layout(local_size_x = NB_WAVEFRONT_GROUP) in;
-
-// Probability of sampling the environment (vs. emissive triangles) in next-event estimation.
-float env_choice_probability() {
-    if (!NB_HAS_ENVIRONMENT) return 0.0f;
-    if (!NB_HAS_EMISSION || params.light_count == 0u) return 1.0f;
-    return 0.5f;
-}
 
 vec3 ray_offset(vec3 p, vec3 n) { return nb_ray_offset(p, n, params.ray_epsilon); }
 
@@ -36,7 +30,8 @@ void main() {
     uint rng = ray_load1(q, NB_RAY_RNG, i);
     float prev_pdf = uintBitsToFloat(ray_load1(q, NB_RAY_PDF, i));
     uint local_pixel = pixel - pc.pixel_offset;
-    float p_env = env_choice_probability();
+    float p_env, p_emissive, p_punctual;
+    nb_light_strategies(p_env, p_emissive, p_punctual);
 
     uint instance = hit_load1(NB_HIT_INSTANCE, i);
     if (instance == NB_NO_HIT) {
@@ -57,7 +52,7 @@ void main() {
         float w = 1.0f;
         if (prev_pdf > 0.0f && params.light_count > 0u) {
             float cos_l = abs(dot(s.ng, dir));
-            float light_pdf = (1.0f - p_env) * nb_emissive_area_pdf(materials[s.material]) * t * t / max(cos_l, 1.0e-8f);
+            float light_pdf = p_emissive * nb_emissive_area_pdf(materials[s.material]) * t * t / max(cos_l, 1.0e-8f);
             w = nb_power_heuristic(prev_pdf, light_pdf);
         }
         sample_radiance[local_pixel] += throughput * s.emission * w;
@@ -65,28 +60,34 @@ void main() {
     if (depth + 1u >= params.max_depth) return; // the next segment would exceed --max-depth
 
     // Next-event estimation.
-    if (NB_HAS_ENVIRONMENT || NB_HAS_EMISSION) {
+    if (NB_HAS_ENVIRONMENT || NB_HAS_EMISSION || NB_HAS_PUNCTUAL) {
         vec3 wi;
         float light_pdf = 0.0f, dist = NB_INF;
         vec3 le = vec3(0.0f);
-        bool pick_env = nb_rng_next(rng) < p_env;
-        if (NB_HAS_ENVIRONMENT && pick_env) {
+        bool delta = false; // punctual: light_pdf is a discrete probability, no MIS
+        float u = nb_rng_next(rng);
+        if (NB_HAS_ENVIRONMENT && u < p_env) {
             le = nb_env_sample(rng, wi, light_pdf);
             light_pdf *= p_env;
-        } else if (NB_HAS_EMISSION && params.light_count > 0u) {
+        } else if (NB_HAS_EMISSION && p_emissive > 0.0f && u < p_env + p_emissive) {
             le = nb_emissive_sample(s.p, rng, wi, dist, light_pdf);
-            light_pdf *= 1.0f - p_env;
+            light_pdf *= p_emissive;
+        } else if (NB_HAS_PUNCTUAL && p_punctual > 0.0f) {
+            le = nb_punctual_sample(s.p, rng, wi, dist, light_pdf);
+            light_pdf *= p_punctual;
+            delta = true;
         }
         if (light_pdf > 0.0f && dot(le, le) > 0.0f) {
             float bsdf_pdf;
             vec3 f = nb_bsdf_eval(s, wo, wi, bsdf_pdf);
             if (dot(f, f) > 0.0f) {
-                vec3 contrib = throughput * f * le * (nb_power_heuristic(light_pdf, bsdf_pdf) / light_pdf);
+                float mis = delta ? 1.0f : nb_power_heuristic(light_pdf, bsdf_pdf);
+                vec3 contrib = throughput * f * le * (mis / light_pdf);
                 uint k = atomicAdd(counters.shadow_count, 1u);
                 vec3 o = ray_offset(s.p, s.ng);
                 shadow_store3(NB_SHADOW_ORIGIN, k, o);
                 shadow_store3(NB_SHADOW_DIR, k, wi);
-                // Stop short of the light's surface so the emitter does not occlude itself.
+                // Stop short of the light (its surface must not occlude itself).
                 float tmax = dist >= NB_INF ? NB_INF : max(0.0f, length(s.p + wi * dist - o) * (1.0f - 1.0e-4f));
                 shadow_store1(NB_SHADOW_TMAX, k, floatBitsToUint(tmax));
                 shadow_store3(NB_SHADOW_CONTRIB, k, contrib);

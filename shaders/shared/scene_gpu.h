@@ -85,15 +85,34 @@ struct GpuTextureInfo {
 NB_STATIC_ASSERT(sizeof(GpuTextureInfo) == 16, "GpuTextureInfo layout");
 
 // ---- Lights -------------------------------------------------------------------------------------
-// An emissive triangle in world space. Selection is proportional to power = luminance(emissive factor)
-// * area, so the area-measure light pdf of a point is luminance(emissive) / total_power: the shader
-// can evaluate it on a BSDF hit without a triangle -> light lookup (needed for MIS).
+// One array of lights: the emissive triangles [0, GpuFrameParams::light_count), then the
+// KHR_lights_punctual lights [light_count, light_count + punctual_count).
+//
+// An emissive triangle (kind NB_LIGHT_TRIANGLE) in world space. Selection is proportional to power =
+// luminance(emissive factor) * area, so the area-measure light pdf of a point is luminance(emissive) /
+// total_power: the shader can evaluate it on a BSDF hit without a triangle -> light lookup (needed for MIS).
+// A single-sided material emits only from its front face, the face rays can hit (back faces are culled):
+// `side` is +1 (front = +cross(p1 - p0, p2 - p0)), -1 (mirroring instance: front = -cross) or 0 (double-sided).
+//
+// A punctual light (NB_LIGHT_POINT / SPOT / DIRECTIONAL) reuses the vertex fields: p0 = position (world),
+// p1 = unit direction the light shines along (world), p2 = colour x intensity (cd; directional: lux), area =
+// range (m, 0 = infinite). Spot cone (KHR_lights_punctual): attenuation = clamp(cos * spot_scale +
+// spot_offset, 0, 1)^2 with cos = dot(p1, -wi); point lights have scale 0, offset 1.
+#define NB_LIGHT_TRIANGLE 0u
+#define NB_LIGHT_POINT 1u
+#define NB_LIGHT_SPOT 2u
+#define NB_LIGHT_DIRECTIONAL 3u
+
 struct GpuLight {
     vec3 p0; uint instance;
     vec3 p1; uint triangle; // global triangle index (for material and uv lookups)
     vec3 p2; float area;    // world-space area (m^2)
+    uint kind;              // NB_LIGHT_*
+    float side;             // triangles: which faces emit (see above)
+    float spot_scale;       // punctual: cone attenuation (see above)
+    float spot_offset;
 };
-NB_STATIC_ASSERT(sizeof(GpuLight) == 48, "GpuLight layout");
+NB_STATIC_ASSERT(sizeof(GpuLight) == 64, "GpuLight layout");
 
 // ---- Per-render parameters ----------------------------------------------------------------------
 // One struct in a storage buffer (too big for push constants).
@@ -109,7 +128,7 @@ struct GpuFrameParams {
     float env_intensity; float env_rotation;
     float env_inv_mean; // 1 / mean(luminance * sin(theta)) over the map: converts f(u,v) into a pdf
     // emissive-triangle lights
-    uint light_count;
+    uint light_count;      // emissive triangles (0 when they have no power)
     float light_total_power; // sum of luminance(emissive) * area
     // path tracing
     uint max_depth;        // path segments (1 = direct light only)
@@ -119,7 +138,9 @@ struct GpuFrameParams {
     uint wave_capacity;    // rays per queue (pixels processed per wave)
     float ray_epsilon;     // origin offset along the geometric normal, scaled by the scene size (m)
     uint instance_count;
-    uint pad0, pad1;
+    uint punctual_count;   // KHR_lights_punctual lights after the emissive triangles in the light array;
+                           // their power cdf follows the emissive one in light_cdf (at light_count + 1)
+    uint pad1;
 };
 NB_STATIC_ASSERT(sizeof(GpuFrameParams) == 128, "GpuFrameParams layout");
 
@@ -154,6 +175,7 @@ NB_STATIC_ASSERT(sizeof(GpuFrameParams) == 128, "GpuFrameParams layout");
 #define NB_SC_ALPHA_MASK 4u
 #define NB_SC_TRANSMISSION 5u
 #define NB_SC_NEURAL 6u
-#define NB_SC_COUNT 7u
+#define NB_SC_PUNCTUAL_LIGHTS 7u
+#define NB_SC_COUNT 8u
 
 #endif

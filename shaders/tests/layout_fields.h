@@ -67,12 +67,12 @@
     NB_LAYOUT_TEXREF(F, base_color_tex) NB_LAYOUT_TEXREF(F, metallic_roughness_tex)              \
     NB_LAYOUT_TEXREF(F, normal_tex) NB_LAYOUT_TEXREF(F, emissive_tex)
 #define NB_LAYOUT_FIELDS_GpuTextureInfo(F) F(offset) F(width) F(height) F(pad)
-#define NB_LAYOUT_FIELDS_GpuLight(F) F(p0) F(instance) F(p1) F(triangle) F(p2) F(area)
+#define NB_LAYOUT_FIELDS_GpuLight(F) F(p0) F(instance) F(p1) F(triangle) F(p2) F(area) F(kind) F(side) F(spot_scale) F(spot_offset)
 #define NB_LAYOUT_FIELDS_GpuFrameParams(F)                                                        \
     F(cam_eye) F(cam_tan_half_fov) F(cam_forward) F(aspect) F(cam_right) F(width) F(cam_up)       \
     F(height) F(env_width) F(env_height) F(env_intensity) F(env_rotation) F(env_inv_mean)         \
     F(light_count) F(light_total_power) F(max_depth) F(rr_start_depth) F(seed) F(spp)             \
-    F(wave_capacity) F(ray_epsilon) F(instance_count) F(pad0) F(pad1)
+    F(wave_capacity) F(ray_epsilon) F(instance_count) F(punctual_count) F(pad1)
 #define NB_LAYOUT_FIELDS_GpuPendingLeaf(F) F(ray) F(instance) F(leaf) F(t_enter) F(t_exit) F(group) F(hit_t) F(hit_normal) F(hit_albedo)
 #define NB_LAYOUT_FIELDS_GpuDispatchArgs(F) F(x) F(y) F(z)
 #define NB_LAYOUT_FIELDS_GpuQueueCounters(F)                                                      \

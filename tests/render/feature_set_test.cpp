@@ -40,6 +40,25 @@ TEST(FeatureSet, EnvironmentTurnsOnShadowPass) {
     EXPECT_NE(explain(f, 4).find("shadow.comp"), std::string::npos);
 }
 
+// KHR_lights_punctual lights alone (no environment, no emitter) switch the shadow pass on; dark ones do not.
+TEST(FeatureSet, PunctualLightsTurnOnShadowPass) {
+    Scene s = test::make_quad_scene();
+    PunctualLight dark;
+    dark.intensity = 0.0f;
+    s.lights.push_back(dark);
+    EXPECT_FALSE(derive_features(s, Environment{}).has_lights());
+    s.lights.push_back(PunctualLight{});
+    const SceneFeatures f = derive_features(s, Environment{});
+    EXPECT_TRUE(f.punctual);
+    EXPECT_FALSE(f.environment);
+    EXPECT_FALSE(f.emission);
+    EXPECT_TRUE(f.has_lights());
+    EXPECT_TRUE(has_pass(pass_list(f), "passes/shadow.comp"));
+    EXPECT_EQ(specialization(f)[NB_SC_PUNCTUAL_LIGHTS].value, 1u);
+    EXPECT_NE(explain(f, 4).find("punctual lights yes"), std::string::npos);
+    EXPECT_NE(explain(f, 4).find("shadow.comp"), std::string::npos);
+}
+
 TEST(FeatureSet, MaterialsDecideTheirFeatures) {
     Scene s = test::make_quad_scene();
     s.textures.push_back(Texture{"t", 1, 1, {255, 255, 255, 255}});

@@ -43,10 +43,71 @@ TEST(GpuScene, EmissiveTrianglesBecomePowerWeightedLights) {
     ASSERT_EQ(d.lights.size(), 2u);
     EXPECT_NEAR(d.lights[0].area + d.lights[1].area, 16.0f, 1e-4f); // 2x2 quad scaled by 2
     EXPECT_NEAR(d.light_total_power, 16.0f, 1e-3f);                // luminance(1,1,1) = 1
-    ASSERT_EQ(d.light_cdf.size(), 3u);
+    EXPECT_EQ(d.emissive_light_count, 2u);
+    EXPECT_EQ(d.punctual_light_count, 0u);
+    ASSERT_EQ(d.light_cdf.size(), 4u); // 3 emissive entries, then the (empty) punctual cdf's single 0
     EXPECT_FLOAT_EQ(d.light_cdf[0], 0.0f);
     EXPECT_NEAR(d.light_cdf[1], 0.5f, 1e-5f);
     EXPECT_FLOAT_EQ(d.light_cdf[2], 1.0f);
+    for (const GpuLight& l : d.lights) {
+        EXPECT_EQ(l.kind, NB_LIGHT_TRIANGLE);
+        EXPECT_EQ(l.side, 1.0f) << "single-sided: emits from its front face";
+    }
+    // A mirroring instance turns the world-space winding around; a double-sided material emits both ways.
+    s.instances[0].object_to_world = glm::scale(glm::mat4(1.0f), glm::vec3(-1.0f, 1.0f, 1.0f));
+    const GpuSceneData m = pack_scene(s, build_scene_accel(s), Environment{});
+    EXPECT_EQ(m.lights[0].side, -1.0f);
+    s.materials[0].double_sided = true;
+    const GpuSceneData t = pack_scene(s, build_scene_accel(s), Environment{});
+    EXPECT_EQ(t.lights[0].side, 0.0f);
+}
+
+// KHR_lights_punctual lights follow the emissive triangles, with their own power cdf after the emissive one:
+// point 4 pi I, spot 2 pi I (1 - (cos inner + cos outer) / 2), directional pi r^2 E (r: half the scene diagonal).
+TEST(GpuScene, PunctualLightsFollowTheEmissiveTrianglesWithAPowerCdf) {
+    Scene s = test::make_quad_scene();
+    s.materials[0].emissive = glm::vec3(1.0f);
+    PunctualLight point, spot, sun, off;
+    point.intensity = 2.0f;
+    point.position = {0, 0, 1};
+    point.range = 5.0f;
+    spot.type = LightType::spot;
+    spot.intensity = 4.0f;
+    spot.color = {1, 0, 0};
+    spot.inner_cone = 0.0f;
+    spot.outer_cone = 3.14159265f / 3.0f; // cos = 0.5
+    spot.direction = {0, 0, -1};
+    sun.type = LightType::directional;
+    sun.intensity = 1.0f;
+    sun.direction = {0, -1, 0};
+    off.intensity = 0.0f; // no power: not packed
+    s.lights = {point, off, spot, sun};
+    const GpuSceneData d = pack_scene(s, build_scene_accel(s), Environment{});
+    ASSERT_EQ(d.emissive_light_count, 2u);
+    ASSERT_EQ(d.punctual_light_count, 3u);
+    ASSERT_EQ(d.lights.size(), 5u);
+    const GpuLight& p = d.lights[2];
+    const GpuLight& sp = d.lights[3];
+    const GpuLight& sn = d.lights[4];
+    EXPECT_EQ(p.kind, NB_LIGHT_POINT);
+    EXPECT_EQ(sp.kind, NB_LIGHT_SPOT);
+    EXPECT_EQ(sn.kind, NB_LIGHT_DIRECTIONAL);
+    EXPECT_FLOAT_EQ(p.area, 5.0f) << "range";
+    EXPECT_FLOAT_EQ(p.p2.x, 2.0f);
+    EXPECT_FLOAT_EQ(p.spot_scale, 0.0f);
+    EXPECT_FLOAT_EQ(p.spot_offset, 1.0f);
+    // Spot: clamp(cos * scale + offset) is 1 at cos_inner = 1, 0 at cos_outer = 0.5.
+    EXPECT_NEAR(1.0f * sp.spot_scale + sp.spot_offset, 1.0f, 1e-5f);
+    EXPECT_NEAR(0.5f * sp.spot_scale + sp.spot_offset, 0.0f, 1e-5f);
+    EXPECT_FLOAT_EQ(sn.p1.y, -1.0f);
+    // Powers: point 4 pi 2; spot 2 pi luminance(4, 0, 0) (1 - 0.75); sun pi r^2 (r^2 = 8/4 = 2 for the 2x2 quad).
+    const double pp = 4.0 * 3.14159265 * 2.0, ps = 2.0 * 3.14159265 * 4.0 * 0.2126 * 0.25, pd = 3.14159265 * 2.0;
+    const double total = pp + ps + pd;
+    ASSERT_EQ(d.light_cdf.size(), 3u + 4u);
+    EXPECT_FLOAT_EQ(d.light_cdf[3], 0.0f);
+    EXPECT_NEAR(d.light_cdf[4], pp / total, 1e-5);
+    EXPECT_NEAR(d.light_cdf[5], (pp + ps) / total, 1e-5);
+    EXPECT_FLOAT_EQ(d.light_cdf[6], 1.0f);
 }
 
 TEST(EnvironmentTable, CdfsAreMonotoneAndDensityAveragesToOne) {

@@ -62,23 +62,30 @@ std::string load_error(const fs::path& path) {
 TEST(GltfSupport, EachUnsupportedExtensionIsNamedOnce) {
     const fs::path dir = nbvh::test::temp_dir("gltf_support_once");
     nbvh::test::GltfBuilder b = quad_gltf();
-    // Three materials with sheen, two nodes with a light, one undeclared made-up extension, one supported.
-    b.doc["extensionsUsed"] = {"KHR_materials_sheen", "KHR_lights_punctual", "KHR_texture_transform"};
+    // Three materials with sheen, two nodes with GPU instancing, one undeclared made-up extension, two
+    // supported ones (lights on two nodes).
+    b.doc["extensionsUsed"] = {"KHR_materials_sheen", "EXT_mesh_gpu_instancing", "KHR_texture_transform",
+                               "KHR_lights_punctual"};
     b.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}}};
     for (int m = 0; m < 3; ++m)
         b.doc["materials"].push_back({{"extensions", {{"KHR_materials_sheen", {{"sheenRoughnessFactor", 0.5}}}}}});
     b.doc["meshes"][0]["primitives"][0]["material"] = 2;
-    b.doc["nodes"] = {{{"mesh", 0}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}},
-                      {{"mesh", 0}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}},
+    const nlohmann::json instancing = {{"attributes", nlohmann::json::object()}};
+    b.doc["nodes"] = {{{"mesh", 0},
+                       {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}, {"EXT_mesh_gpu_instancing", instancing}}}},
+                      {{"mesh", 0},
+                       {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}, {"EXT_mesh_gpu_instancing", instancing}}}},
                       {{"mesh", 0}, {"extensions", {{"EXT_made_up", nlohmann::json::object()}}}}};
     b.doc["scenes"] = {{{"nodes", {0, 1, 2}}}};
     nbvh::Scene s;
     const std::vector<std::string> lines = load_logged(write_gltf(dir / "ext.gltf", b.finish()), &s);
     EXPECT_EQ(s.instances.size(), 3u) << "the scene still loads";
     EXPECT_EQ(lines_with(lines, "KHR_materials_sheen"), 1u);
-    EXPECT_EQ(lines_with(lines, "KHR_lights_punctual"), 1u);
+    EXPECT_EQ(lines_with(lines, "EXT_mesh_gpu_instancing"), 1u);
     EXPECT_EQ(lines_with(lines, "EXT_made_up"), 1u) << "undeclared extensions are named too";
     EXPECT_EQ(lines_with(lines, "KHR_texture_transform"), 0u) << "supported: no line";
+    EXPECT_EQ(lines_with(lines, "KHR_lights_punctual"), 0u) << "supported: no line";
+    EXPECT_EQ(s.lights.size(), 2u);
     for (const std::string& l : lines) EXPECT_EQ(l.rfind("warning: ", 0), 0u) << l;
 }
 
