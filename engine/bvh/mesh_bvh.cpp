@@ -66,6 +66,9 @@ bool intersect(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit&
         for (uint32_t k = n.first; k < n.first + n.count; ++k) {
             float t, u, w;
             if (nb_intersect_triangle(ray.org, ray.dir, v[3 * k], v[3 * k + 1], v[3 * k + 2], tmin, t_max, t, u, w)) {
+                if (!mesh.single_sided.empty() && mesh.single_sided[k] &&
+                    nb_back_facing(v[3 * k], v[3 * k + 1], v[3 * k + 2], ray.dir))
+                    continue;
                 found = true;
                 t_max = t;
                 hit = Hit{t, bvh.prim_indices[k], u, w};
@@ -88,19 +91,36 @@ bool intersect_any(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax) 
     return intersect<true>(mesh, ray, tmin, tmax, h);
 }
 
-bool intersect_closest_brute_force(const Mesh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit) {
+bool intersect_closest_brute_force(const Mesh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit,
+                                   const std::vector<Material>* materials) {
     bool found = false;
     for (uint32_t tri = 0; tri < mesh.triangle_count(); ++tri) {
         glm::vec3 a, b, c;
         if (!triangle_vertices(mesh, tri, a, b, c) || !is_finite(a) || !is_finite(b) || !is_finite(c)) continue;
         float t, u, v;
         if (nb_intersect_triangle(ray.org, ray.dir, a, b, c, tmin, tmax, t, u, v)) {
+            if (materials && tri < mesh.triangle_material.size() && mesh.triangle_material[tri] < materials->size() &&
+                !(*materials)[mesh.triangle_material[tri]].double_sided && nb_back_facing(a, b, c, ray.dir))
+                continue;
             found = true;
             tmax = t;
             hit = Hit{t, tri, u, v};
         }
     }
     return found;
+}
+
+std::vector<uint8_t> single_sided_flags(const Mesh& mesh, const MeshBvh& bvh, const std::vector<Material>& materials) {
+    std::vector<uint8_t> flags(bvh.bvh.prim_indices.size(), 0);
+    bool any = false;
+    for (size_t k = 0; k < flags.size(); ++k) {
+        const uint32_t tri = bvh.bvh.prim_indices[k];
+        const uint32_t m = tri < mesh.triangle_material.size() ? mesh.triangle_material[tri] : 0u;
+        flags[k] = m < materials.size() && !materials[m].double_sided;
+        any = any || flags[k];
+    }
+    if (!any) flags.clear();
+    return flags;
 }
 
 } // namespace nbvh

@@ -18,6 +18,10 @@ struct MeshBvh {
     // vertices[3k..3k+2] and original id bvh.prim_indices[k]. Triangles the builder skipped
     // (non-finite vertices, out-of-range indices) are not present.
     std::vector<glm::vec3> vertices;
+    // Per triangle in leaf order: 1 = single-sided material, its back faces are culled by the queries below
+    // (glTF doubleSided false; the GPU traversal does the same). Empty: nothing is culled (build_mesh_bvh
+    // leaves it empty; build_scene_accel fills it from the scene's materials).
+    std::vector<uint8_t> single_sided;
     uint32_t triangle_count() const { return uint32_t(bvh.prim_indices.size()); }
     Aabb bounds() const { return bvh.empty() ? Aabb{} : bvh.nodes[0].bounds; }
 };
@@ -38,7 +42,13 @@ bool intersect_closest(const MeshBvh& mesh, const Ray& ray, float tmin, float tm
 // Any hit with t in [tmin, tmax] (shadow rays).
 bool intersect_any(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax);
 
-// Reference: tests every triangle of `mesh` (same intersect.h math). For tests and debugging.
-bool intersect_closest_brute_force(const Mesh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit);
+// Reference: tests every triangle of `mesh` (same intersect.h math). For tests and debugging. With
+// `materials`, back faces of single-sided ones are culled as in the BVH queries.
+bool intersect_closest_brute_force(const Mesh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit,
+                                   const std::vector<Material>* materials = nullptr);
+
+// 1 per triangle of `mesh` in `bvh` leaf order when its material (index into `materials`) is single-sided;
+// empty when every material is double-sided (MeshBvh::single_sided).
+std::vector<uint8_t> single_sided_flags(const Mesh& mesh, const MeshBvh& bvh, const std::vector<Material>& materials);
 
 } // namespace nbvh

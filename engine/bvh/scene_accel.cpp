@@ -72,7 +72,10 @@ SceneAccel build_scene_accel(const Scene& scene, const BvhBuildOptions& blas_opt
                              const BvhBuildOptions& tlas_options) {
     SceneAccel accel;
     accel.meshes.reserve(scene.meshes.size());
-    for (const Mesh& mesh : scene.meshes) accel.meshes.push_back(build_mesh_bvh(mesh, blas_options));
+    for (const Mesh& mesh : scene.meshes) {
+        accel.meshes.push_back(build_mesh_bvh(mesh, blas_options));
+        accel.meshes.back().single_sided = single_sided_flags(mesh, accel.meshes.back(), scene.materials);
+    }
 
     const size_t n = scene.instances.size();
     accel.object_to_world.resize(n);
@@ -111,7 +114,7 @@ bool intersect_closest_brute_force(const Scene& scene, const Ray& ray, float tmi
         if (inst.mesh >= scene.meshes.size() || !safe_inverse(inst.object_to_world, inv)) continue;
         Hit h;
         // Same object-space ray as the TLAS path, so both agree bit for bit.
-        if (intersect_closest_brute_force(scene.meshes[inst.mesh], to_object(inv, ray), tmin, tmax, h)) {
+        if (intersect_closest_brute_force(scene.meshes[inst.mesh], to_object(inv, ray), tmin, tmax, h, &scene.materials)) {
             found = true;
             tmax = h.t;
             hit = SceneHit{h.t, i, h.triangle, h.u, h.v};

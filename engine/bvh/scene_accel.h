@@ -36,7 +36,9 @@ SceneAccel build_scene_accel(const Scene& scene, const BvhBuildOptions& blas_opt
                              const BvhBuildOptions& tlas_options = default_tlas_options());
 
 // World-space queries. The ray is transformed into each instance's object space without
-// renormalising the direction, so t is the same parameter in world and object space.
+// renormalising the direction, so t is the same parameter in world and object space. Back faces of
+// single-sided materials are culled (MeshBvh::single_sided), as in the GPU traversal; outline shells
+// (outline_shells.h) count as hit, as for the GPU's camera rays and WavefrontRenderer::trace.
 bool intersect_closest(const SceneAccel& accel, const Ray& ray, float tmin, float tmax, SceneHit& hit);
 bool intersect_any(const SceneAccel& accel, const Ray& ray, float tmin, float tmax);
 

@@ -54,6 +54,7 @@ SceneFeatures derive_features(const Scene& scene, const Environment& environment
         if (texture_exists(scene, m.normal_tex)) f.normal_maps = true;
         if (m.emissive.x > 0.0f || m.emissive.y > 0.0f || m.emissive.z > 0.0f) f.emission = true;
         if (m.alpha_mode != AlphaMode::opaque) f.alpha_mask = true;
+        if (!m.double_sided) f.single_sided = true;
         if (m.transmission > 0.0f && m.metallic < 1.0f) f.transmission = true;
     }
     // Without a model (or with --classical) neural instances render from their triangles.
@@ -71,7 +72,8 @@ std::vector<vk::SpecConstant> specialization(const SceneFeatures& f) {
     return {{NB_SC_TEXTURES, f.textures ? 1u : 0u},       {NB_SC_NORMAL_MAPS, f.normal_maps ? 1u : 0u},
             {NB_SC_EMISSION, f.emission ? 1u : 0u},       {NB_SC_ENVIRONMENT, f.environment ? 1u : 0u},
             {NB_SC_ALPHA_MASK, f.alpha_mask ? 1u : 0u},   {NB_SC_TRANSMISSION, f.transmission ? 1u : 0u},
-            {NB_SC_NEURAL, f.neural ? 1u : 0u},           {NB_SC_PUNCTUAL_LIGHTS, f.punctual ? 1u : 0u}};
+            {NB_SC_NEURAL, f.neural ? 1u : 0u},           {NB_SC_PUNCTUAL_LIGHTS, f.punctual ? 1u : 0u},
+            {NB_SC_SINGLE_SIDED, f.single_sided ? 1u : 0u}};
 }
 
 std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene, const NeuralRenderOptions& o) {
@@ -144,6 +146,7 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
     s += strfmt("  punctual lights %s%s\n", yn(f.punctual), f.punctual ? "  (KHR_lights_punctual NEE, shadow rays)" : "");
     s += strfmt("  alpha masks     %s%s\n", yn(f.alpha_mask), f.alpha_mask ? "  (alpha test in traversal)" : "");
     s += strfmt("  transmission    %s\n", yn(f.transmission));
+    s += strfmt("  single-sided    %s%s\n", yn(f.single_sided), f.single_sided ? "  (back faces culled in traversal)" : "");
     if (n) {
         s += strfmt("  neural assets   yes  (%u instance%s answered by the model's %u asset%s)\n", n->instances,
                     n->instances == 1 ? "" : "s", n->assets, n->assets == 1 ? "" : "s");

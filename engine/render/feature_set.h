@@ -22,6 +22,7 @@ struct SceneFeatures {
     bool transmission = false;  // KHR_materials_transmission
     bool neural = false;        // hybrid render: neural instances answered by the model's N-BVH + MLP
     bool punctual = false;      // KHR_lights_punctual lights of positive intensity (-> punctual NEE)
+    bool single_sided = false;  // some material is single-sided (-> back-face culling in traversal)
 
     // Any light that next-event estimation can sample: the shadow pass runs only then.
     bool has_lights() const { return emission || environment || punctual; }

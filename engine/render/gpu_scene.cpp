@@ -5,6 +5,7 @@
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
+#include "engine/scene/outline_shells.h"
 #include "shaders/shared/sampling.h"
 
 namespace nbvh::render {
@@ -212,7 +213,8 @@ GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Envir
     if (out.triangles.empty()) out.triangles.push_back(GpuTriangle{0, 0, 0, 0});
     if (out.blas_nodes.empty()) out.blas_nodes.push_back(GpuBvhNode{});
 
-    // Instances in TLAS leaf order.
+    // Instances in TLAS leaf order; inverted-hull outlines are seen by camera rays only (outline_shells.h).
+    const std::vector<bool> shells = find_outline_shells(scene);
     out.tlas_nodes = to_gpu_layout(accel.tlas);
     for (uint32_t scene_instance : accel.tlas.prim_indices) {
         const uint32_t mesh = accel.instance_mesh[scene_instance];
@@ -221,7 +223,8 @@ GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Envir
         rows_of(accel.world_to_object[scene_instance], g.world_to_object);
         g.blas_root = mesh_blas_root[mesh];
         g.first_triangle = mesh_triangle_base[mesh];
-        g.kind = NB_INSTANCE_TRIANGLES;
+        g.kind = shells[scene_instance] ? NB_INSTANCE_CAMERA_ONLY : NB_INSTANCE_TRIANGLES;
+        out.outline_shells += shells[scene_instance];
         g.mesh = mesh;
         out.instances.push_back(g);
         out.instance_to_scene.push_back(scene_instance);
@@ -235,6 +238,9 @@ GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Envir
         out.tlas_nodes.push_back(empty);
     }
     if (no_instances) out.instances.push_back(GpuInstance{});
+    if (out.outline_shells > 0)
+        log_info("render: %u inverted-hull outline shell%s (inward-facing, single-sided, around other geometry): seen "
+                 "by camera rays only", out.outline_shells, out.outline_shells == 1 ? "" : "s");
 
     // Materials and textures.
     for (const Material& m : scene.materials) out.materials.push_back(pack_material(m, scene.textures.size()));
@@ -247,6 +253,7 @@ GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Envir
     if (!no_instances) {
         for (uint32_t gi = 0; gi < out.instances.size(); ++gi) {
             const uint32_t si = out.instance_to_scene[gi];
+            if (out.instances[gi].kind == NB_INSTANCE_CAMERA_ONLY) continue; // lights nothing it could shadow
             const uint32_t mesh = accel.instance_mesh[si];
             const glm::mat4& o2w = accel.object_to_world[si];
             const uint32_t first = mesh_triangle_base[mesh];

@@ -34,6 +34,7 @@ struct GpuSceneData {
     std::vector<uint32_t> triangle_to_mesh_triangle; // GPU triangle -> original triangle id in its mesh
     float scene_extent = 1.0f;                  // world bounds diagonal (m)
     uint32_t texture_downscales = 0;            // halvings applied to fit the texel budget
+    uint32_t outline_shells = 0;                // instances packed as NB_INSTANCE_CAMERA_ONLY
 };
 
 struct PackOptions {

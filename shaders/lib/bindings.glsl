@@ -19,6 +19,7 @@ layout(constant_id = NB_SC_ALPHA_MASK) const bool NB_HAS_ALPHA_MASK = false;
 layout(constant_id = NB_SC_TRANSMISSION) const bool NB_HAS_TRANSMISSION = false;
 layout(constant_id = NB_SC_NEURAL) const bool NB_HAS_NEURAL = false;
 layout(constant_id = NB_SC_PUNCTUAL_LIGHTS) const bool NB_HAS_PUNCTUAL = false;
+layout(constant_id = NB_SC_SINGLE_SIDED) const bool NB_HAS_SINGLE_SIDED = false;
 
 layout(push_constant, scalar) uniform PassConstantsBlock { GpuPassConstants pc; };
 

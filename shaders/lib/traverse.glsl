@@ -6,7 +6,8 @@
 //     instances transform the ray and traverse their BLAS with nb_triangle_leaf. The neural issue adds
 //     the NB_INSTANCE_NEURAL case (traverse the N-BVH, append (ray, leaf) pairs to the pending-leaf
 //     queue and suspend the ray at the nearest one) without touching the triangle path.
-//   - nb_triangle_leaf: ray/triangle tests (shared/intersect.h), alpha masks when the scene has them.
+//   - nb_triangle_leaf: ray/triangle tests (shared/intersect.h), back-face culling of single-sided
+//     materials and alpha masks when the scene has them.
 //
 // State lives in per-invocation globals (GLSL has neither references nor recursion). Rays are not
 // re-normalised in object space, so t is the same distance in world and object space.
@@ -24,6 +25,7 @@ uint g_hit_instance;   // NB_NO_HIT until a hit is accepted
 uint g_hit_triangle;
 vec2 g_hit_bary;
 bool g_any_hit;        // shadow rays: stop at the first accepted hit
+bool g_camera_ray = false; // camera rays also see NB_INSTANCE_CAMERA_ONLY instances (outline shells)
 bool g_done;
 uint g_alpha_seed;     // per-ray random bits for stochastic alpha blending
 uint g_cur_instance;   // instance whose BLAS is being traversed
@@ -92,9 +94,12 @@ void nb_triangle_leaf(uint first, uint count) {
     for (uint k = 0u; k < count; ++k) {
         uint tri_index = inst.first_triangle + first + k;
         GpuTriangle tri = triangles[tri_index];
+        vec3 p0 = vertices[tri.v0].position, p1 = vertices[tri.v1].position, p2 = vertices[tri.v2].position;
         float t, u, v;
-        if (!nb_intersect_triangle(g_obj_org, g_obj_dir, vertices[tri.v0].position, vertices[tri.v1].position,
-                                   vertices[tri.v2].position, g_tmin, g_tmax, t, u, v))
+        if (!nb_intersect_triangle(g_obj_org, g_obj_dir, p0, p1, p2, g_tmin, g_tmax, t, u, v)) continue;
+        // glTF doubleSided false: every ray (camera, continuation, shadow) passes through back faces, so
+        // NEE and BSDF sampling see the same scene.
+        if (NB_HAS_SINGLE_SIDED && materials[tri.material].double_sided == 0u && nb_back_facing(p0, p1, p2, g_obj_dir))
             continue;
         if (!nb_alpha_accepts(tri, vec2(u, v))) continue;
         g_tmax = t;
@@ -125,7 +130,8 @@ void nb_instance_leaf(uint first, uint count) {
     for (uint k = 0u; k < count && !g_done; ++k) {
         uint instance = first + k;
         uint kind = instances[instance].kind;
-        if (kind == NB_INSTANCE_TRIANGLES && !g_nl_skip_triangles) nb_traverse_triangle_instance(instance);
+        bool triangles = kind == NB_INSTANCE_TRIANGLES || (kind == NB_INSTANCE_CAMERA_ONLY && g_camera_ray);
+        if (triangles && !g_nl_skip_triangles) nb_traverse_triangle_instance(instance);
         else if (NB_HAS_NEURAL && kind == NB_INSTANCE_NEURAL) nb_traverse_neural_instance(instance);
     }
 }

@@ -59,6 +59,7 @@ void main() {
     nb_nl_begin(st, pc.depth == 0u ? neural_params.lod_primary : neural_params.lod_secondary, nb_nl_want(st));
     if (op == 0u) {
         g_nl_skip_triangles = false;
+        g_camera_ray = pc.depth == 0u; // outline shells (NB_INSTANCE_CAMERA_ONLY) are seen by camera rays only
         nb_trace(org, dir, t_resume, NB_INF, false);
         st.tri_t = g_hit_instance == NB_NO_HIT ? NB_INF : g_tmax;
         st.tri_instance = g_hit_instance;

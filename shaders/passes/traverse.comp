@@ -14,6 +14,7 @@ void main() {
     vec3 dir = ray_load3(q, NB_RAY_DIR, i);
     g_alpha_seed = ray_load1(q, NB_RAY_RNG, i);
     float t_resume = uintBitsToFloat(ray_load1(q, NB_RAY_T_RESUME, i));
+    g_camera_ray = pc.depth == 0u;
     nb_trace(org, dir, t_resume, NB_INF, false);
     hit_store1(NB_HIT_T, i, floatBitsToUint(g_hit_instance == NB_NO_HIT ? NB_INF : g_tmax));
     hit_store1(NB_HIT_INSTANCE, i, g_hit_instance);

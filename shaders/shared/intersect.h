@@ -137,4 +137,10 @@ NB_FN bool nb_intersect_triangle(vec3 org, vec3 dir, vec3 v0, vec3 v1, vec3 v2, 
     return true;
 }
 
+// Back face of a single-sided triangle (glTF material doubleSided false: back faces are culled): the ray
+// travels along the counter-clockwise normal cross(v1 - v0, v2 - v0), i.e. meets the triangle from behind.
+// Use it in object space: a mirroring instance (negative determinant) turns the world-space winding and,
+// by glTF 2.0 §3.7.4, the front face with it, so the object-space test needs no determinant.
+NB_FN bool nb_back_facing(vec3 v0, vec3 v1, vec3 v2, vec3 dir) { return dot(cross(v1 - v0, v2 - v0), dir) > 0.0f; }
+
 #endif // NB_INTERSECT_H

@@ -13,6 +13,9 @@
 // the triangle handler traverses a BLAS, the neural handler (later issue) queues (ray, leaf) pairs.
 #define NB_INSTANCE_TRIANGLES 0u
 #define NB_INSTANCE_NEURAL 1u
+// Triangles seen by camera rays only: an inverted-hull outline shell (engine/scene/outline_shells.h),
+// which rasterizing viewers draw at silhouettes and which must not shadow or hide what it encloses.
+#define NB_INSTANCE_CAMERA_ONLY 2u
 
 struct GpuInstance {
     vec4 object_to_world[3]; // rows of the affine 3x4 matrix
@@ -64,7 +67,7 @@ struct GpuMaterial {
     float alpha_cutoff;
     float transmission;
     uint alpha_mode;      // NB_ALPHA_*
-    uint double_sided;
+    uint double_sided;    // 0: back faces are culled for every ray (lib/traverse.glsl)
     uint pad0, pad1;
     GpuTexRef base_color_tex;          // sRGB
     GpuTexRef metallic_roughness_tex;  // linear: G roughness, B metallic
@@ -176,6 +179,7 @@ NB_STATIC_ASSERT(sizeof(GpuFrameParams) == 128, "GpuFrameParams layout");
 #define NB_SC_TRANSMISSION 5u
 #define NB_SC_NEURAL 6u
 #define NB_SC_PUNCTUAL_LIGHTS 7u
-#define NB_SC_COUNT 8u
+#define NB_SC_SINGLE_SIDED 8u
+#define NB_SC_COUNT 9u
 
 #endif

@@ -15,7 +15,8 @@ bool has_pass(const std::vector<std::string>& passes, const std::string& name) {
 }
 
 TEST(FeatureSet, PlainSceneWithoutLightsHasNoShadowPass) {
-    const Scene s = test::make_quad_scene();
+    Scene s = test::make_quad_scene();
+    s.materials[0].double_sided = true; // no back-face culling either
     const SceneFeatures f = derive_features(s, Environment{});
     EXPECT_FALSE(f.textures);
     EXPECT_FALSE(f.normal_maps);
@@ -23,6 +24,7 @@ TEST(FeatureSet, PlainSceneWithoutLightsHasNoShadowPass) {
     EXPECT_FALSE(f.environment);
     EXPECT_FALSE(f.alpha_mask);
     EXPECT_FALSE(f.transmission);
+    EXPECT_FALSE(f.single_sided);
     EXPECT_FALSE(f.has_lights());
     EXPECT_FALSE(has_pass(pass_list(f), "passes/shadow.comp"));
     EXPECT_TRUE(has_pass(pass_list(f), "passes/traverse.comp"));
@@ -57,6 +59,15 @@ TEST(FeatureSet, PunctualLightsTurnOnShadowPass) {
     EXPECT_EQ(specialization(f)[NB_SC_PUNCTUAL_LIGHTS].value, 1u);
     EXPECT_NE(explain(f, 4).find("punctual lights yes"), std::string::npos);
     EXPECT_NE(explain(f, 4).find("shadow.comp"), std::string::npos);
+}
+
+TEST(FeatureSet, SingleSidedMaterialsTurnOnBackFaceCulling) {
+    Scene s = test::make_quad_scene();
+    const SceneFeatures f = derive_features(s, Environment{});
+    EXPECT_TRUE(f.single_sided) << "glTF's default material is single-sided";
+    EXPECT_EQ(specialization(f)[NB_SC_SINGLE_SIDED].value, 1u);
+    s.materials[0].double_sided = true;
+    EXPECT_FALSE(derive_features(s, Environment{}).single_sided);
 }
 
 TEST(FeatureSet, MaterialsDecideTheirFeatures) {

@@ -80,7 +80,8 @@ TEST(Render, QuadUnderConstantSky) {
 
 TEST(Render, EmissiveQuadLightsFloorWithoutEnvironment) {
     Scene s = test::make_quad_scene();
-    // A small emissive quad facing down above the floor quad (rotated to face +y).
+    // A small emissive quad facing down above the floor quad (rotated to face +y). Both single-sided: the
+    // camera above sees the lamp's culled back and the floor through it.
     Material lamp;
     lamp.emissive = glm::vec3(10.0f);
     lamp.base_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
@@ -92,7 +93,7 @@ TEST(Render, EmissiveQuadLightsFloorWithoutEnvironment) {
     Instance li;
     li.mesh = 1;
     li.object_to_world = glm::mat4(1, 0, 0, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 1); // rotate, lift to y = 1
-    s.instances[0].object_to_world = glm::mat4(1, 0, 0, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1);
+    s.instances[0].object_to_world = glm::mat4(1, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1); // floor faces +y
     s.instances.push_back(li);
     s.camera.eye = {0, 2, 3};
     s.camera.target = {0, 0, 0};
