@@ -76,6 +76,10 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     features_ = derive_features(scene, environment);
     PackOptions pack;
     pack.textures = features_.textures;
+    // All texels live in one storage buffer (a sampled-image array would need descriptor indexing,
+    // which Debian 12's lavapipe lacks): up to 3/4 of the device's storage-buffer range, at most 1 GiB
+    // (lavapipe: 96 of 128 MiB; NVIDIA: 1 GiB, so large scenes keep their full-size textures).
+    pack.texel_budget_bytes = std::clamp<uint64_t>(range / 4 * 3, 96ull << 20, 1ull << 30);
     data_ = pack_scene(scene, accel, environment, pack);
     // Neural instances: N-BVH + network (hybrid), or triangles with the neural material constants
     // (classical reference); without either they render as plain triangles.
