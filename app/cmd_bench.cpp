@@ -171,7 +171,7 @@ void add_bench_command(CLI::App& app) {
     cmd->add_option("--json", args->json, "write the table (and per-pass GPU times) as JSON");
     cmd->add_option("--neural-path", args->neural_path, "MLP implementation: auto, scalar or coopmat");
     cmd->add_option("--camera", args->camera, "eye_x,eye_y,eye_z,target_x,target_y,target_z,fov_deg");
-    cmd->add_option("--env", args->env, "environment map (.hdr or .exr, equirectangular)");
+    cmd->add_option("--env", args->env, "environment map (.hdr or .exr, equirectangular), or 'none' (the scene's lights only)");
     cmd->add_option("--env-rotation", args->env_rotation, "rotate the environment about +y by this many degrees")
         ->check(CLI::Range(-3600.0f, 3600.0f));
     cmd->callback([args] { run_bench(*args); });

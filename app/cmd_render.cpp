@@ -1,13 +1,16 @@
 // nbvh render SCENE [--out FILE.png|.exr] [--width --height --spp --max-depth --seed] [--device]
-//                   [--camera ex,ey,ez,tx,ty,tz,fov] [--env FILE.hdr|.exr] [--stats FILE.json] [--explain]
+//                   [--camera ex,ey,ez,tx,ty,tz,fov] [--env FILE.hdr|.exr|none] [--exposure auto|STOPS]
+//                   [--stats FILE.json] [--explain]
 //                   [--model M.nbvh [--lod L] [--secondary-lod L] [--neural-path auto|scalar|coopmat]]
 //                   [--classical] [--neural GLOB] [--neural-roughness R] [--neural-metallic M]
 //                   [--neural-max-leaves N] [--neural-batched-rounds N] [--wave-pixels N]
 // With --model the scene's neural instances are rendered from the model (hybrid); --classical renders
 // them from their triangles with the same material constants (the reference FLIP compares against).
 // Loads the scene, builds its BVHs, runs the wavefront path tracer (engine/render/) and writes the image
-// (PNG: ACES-fit tone map + sRGB, engine/core/image.h; EXR: linear radiance).
+// (PNG: exposure (auto by default, engine/core/exposure.h), ACES-fit tone map + sRGB, engine/core/image.h;
+// EXR: linear radiance).
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -22,6 +25,7 @@
 #include "app/scene_arg.h"
 #include "engine/bvh/scene_accel.h"
 #include "engine/core/error.h"
+#include "engine/core/exposure.h"
 #include "engine/core/image.h"
 #include "engine/core/log.h"
 #include "engine/neural/model_file.h"
@@ -34,14 +38,33 @@ namespace nbvh::app {
 namespace {
 
 struct RenderArgs {
-    std::string scene, out = "render.png", device = "auto", camera, env, stats;
+    std::string scene, out = "render.png", device = "auto", camera, env, stats, exposure = "auto";
     std::optional<float> env_rotation; // degrees
     std::string model, neural_path = "auto", neural_glob;
     render::RenderOptions options;
     bool explain = false;
 };
 
-void write_stats(const std::string& path, const render::RenderStats& s, const std::string& scene) {
+// --exposure: "auto" (nullopt) or stops.
+std::optional<float> parse_exposure(const std::string& text) {
+    if (text == "auto") return std::nullopt;
+    try {
+        size_t used = 0;
+        const float v = std::stof(text, &used);
+        if (used == text.size() && std::isfinite(v) && std::fabs(v) <= 24.0f) return v;
+    } catch (const std::exception&) {
+    }
+    throw Error(strfmt("--exposure '%s': expected 'auto' or a number of stops in [-24, 24]", text.c_str()));
+}
+
+// The exposure of the written image: PNG gets --exposure (auto: from the image), EXR stays linear.
+struct Exposure {
+    std::string mode; // "auto", "fixed" or "none" (EXR)
+    float stops = 0.0f;
+};
+
+void write_stats(const std::string& path, const render::RenderStats& s, const std::string& scene,
+                 const Exposure& exposure) {
     nlohmann::json j;
     j["scene"] = scene;
     j["device"] = s.device;
@@ -60,6 +83,7 @@ void write_stats(const std::string& path, const render::RenderStats& s, const st
     j["rays_per_second"] = s.rays_per_second();
     j["non_finite_samples"] = s.nonfinite_samples;
     j["non_finite_pixels"] = s.nonfinite_pixels;
+    j["exposure"] = {{"mode", exposure.mode}, {"stops", exposure.stops}};
     if (!s.neural_path.empty()) {
         nlohmann::json n;
         n["path"] = s.neural_path;
@@ -80,6 +104,9 @@ void run_render(const RenderArgs& a) {
     const std::vector<std::string> inputs = {a.scene, a.env, a.model};
     check_output_path(a.out, "--out", inputs);
     check_output_path(a.stats, "--stats", inputs);
+    const std::optional<float> fixed_exposure = parse_exposure(a.exposure);
+    if (fixed_exposure && is_exr_path(a.out))
+        log_warn("render: --exposure is ignored for EXR output (linear radiance, unscaled)");
     vk::ContextOptions copt;
     copt.device = vk::parse_device_choice(a.device);
     SceneLoadOptions lo;
@@ -118,14 +145,24 @@ void run_render(const RenderArgs& a) {
         log_info("render: neural %s: %llu queries (%.2f per ray), %.3g queries/s over %.2f ms of query passes",
                  s.neural_path.c_str(), (unsigned long long)s.neural_queries, s.neural_queries_per_ray(),
                  s.neural_queries_per_second(), s.neural_query_ms);
+    Exposure exposure{"none", 0.0f};
     if (is_exr_path(a.out)) {
         save_exr(a.out, convert_channels(result.image, 3));
     } else {
         PngEncode enc;
         enc.tone_map = ToneMap::aces;
+        if (fixed_exposure) {
+            exposure = {"fixed", *fixed_exposure};
+        } else {
+            const AutoExposure ae = auto_exposure(result.image);
+            exposure = {"auto", ae.stops};
+            log_info("render: exposure %+.2f stops (auto: key luminance %.4g of %zu lit pixels, 99th percentile "
+                     "%.4g; --exposure 0 for none)", ae.stops, ae.key, ae.lit_pixels, ae.bright);
+        }
+        enc.exposure = exposure.stops;
         save_png(a.out, result.image, enc);
     }
-    if (!a.stats.empty()) write_stats(a.stats, s, a.scene);
+    if (!a.stats.empty()) write_stats(a.stats, s, a.scene, exposure);
     if (ctx.validation_enabled() && ctx.validation_message_count() > 0)
         log_warn("render: %d Vulkan validation messages", ctx.validation_message_count());
 }
@@ -140,7 +177,12 @@ void add_render_command(CLI::App& app) {
     add_render_option_flags(cmd, args->options); // --width --height --spp --max-depth --seed, neural constants
     cmd->add_option("--device", args->device, "Vulkan device: auto, gpu or cpu (lavapipe)");
     cmd->add_option("--camera", args->camera, "eye_x,eye_y,eye_z,target_x,target_y,target_z,fov_deg");
-    cmd->add_option("--env", args->env, "environment map (.hdr or .exr, equirectangular)");
+    cmd->add_option("--env", args->env,
+                    "environment map (.hdr or .exr, equirectangular), or 'none' for the scene's own emitters and "
+                    "lights only (default: the scene's environment, else the default sky)");
+    cmd->add_option("--exposure", args->exposure,
+                    "PNG exposure in stops, or 'auto' (default): from the image's key luminance; printed and in "
+                    "--stats. EXR output is linear and unscaled");
     cmd->add_option("--env-rotation", args->env_rotation, "rotate the environment about +y by this many degrees")
         ->check(CLI::Range(-3600.0f, 3600.0f));
     cmd->add_option("--stats", args->stats, "write per-pass GPU times, ray counts and checks as JSON");

@@ -27,14 +27,19 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
 }
 
 Environment choose_environment(const Scene& scene, const std::string& env_path) {
+    const render::SceneFeatures f = render::derive_features(scene, Environment{});
+    if (env_path == ENV_NONE) {
+        if (!f.has_lights())
+            log_warn("render: --env none and the scene has no emitter or light: the image is black");
+        return Environment{};
+    }
     if (!env_path.empty()) return load_environment(env_path);
     if (!scene.environment.empty()) return scene.environment;
-    const render::SceneFeatures f = render::derive_features(scene, Environment{});
-    if (!f.emission) {
-        log_info("render: the scene has no lights; lighting it with the default sky (use --env to change)");
-        return default_sky();
-    }
-    return Environment{};
+    // As glTF viewers do: glTF carries no environment, so every scene gets the default one, its own
+    // emitters and lights added (a scene lit only by weak emissive triangles would otherwise be black).
+    log_info("render: lighting with the default sky%s (--env FILE to change, --env none for the scene's own "
+             "lights only)", f.has_lights() ? " and the scene's emitters and lights" : "");
+    return default_sky();
 }
 
 Camera choose_camera(const Scene& scene, const std::string& camera_arg, const render::RenderOptions& o) {

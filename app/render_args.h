@@ -15,9 +15,11 @@ namespace nbvh::app {
 // (which must outlive the parse).
 void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o);
 
-// The environment to light with: `env_path` (--env), else the scene's, else the default sky when nothing
-// else would light the scene (a glTF without lights would otherwise render black).
+// The environment to light with: `env_path` (--env FILE), none for --env none (only the scene's emitters
+// and lights: black background), else the scene's, else the default sky, added to the scene's own
+// emitters and lights (issue 12: every scene is lit as viewers light it).
 Environment choose_environment(const Scene& scene, const std::string& env_path);
+inline constexpr const char* ENV_NONE = "none";
 
 // The view: `camera_arg` (--camera ex,ey,ez,tx,ty,tz,fov), else the scene's, else auto-framed for the
 // image aspect of `o`.

@@ -8,7 +8,7 @@
 # 285 deg as the config says -- our rotation convention may differ from the official renderer's).
 # Usage: scripts/bench/chess.sh SCENE.glb ENV.hdr OUT_DIR
 #   env: NBVH (binary), SPP, REF_SPP, TRAIN_ARGS (extra nbvh train flags), REF (reuse this reference
-#   PNG), NO_CLASSICAL=1 (skip the noise-floor render when REF is reused)
+#   PNG), NO_CLASSICAL=1 (skip the noise-floor render when REF is reused), EXPOSURE (PNG stops, default 0)
 # Writes OUT_DIR/{reference,classical,hybrid,hybrid_flip}.png, *_stats.json, summary.txt.
 set -euo pipefail
 SCENE=$1 ENV=$2 OUT=$3
@@ -19,7 +19,9 @@ mkdir -p "$OUT"
 S="$OUT/summary.txt"
 { nvidia-smi --query-gpu=name,driver_version --format=csv,noheader; echo "train flags: ${TRAIN_ARGS:-(defaults)}";
   echo "spp $SPP, reference ${REF:-$REF_SPP spp}"; } > "$S"
-R=("$NBVH" render "$SCENE" --camera "$CAM" --env "$ENV" --env-rotation 285 --width 1920 --height 1080 --max-depth 8)
+# One fixed exposure (EXPOSURE stops, default 0 as in the committed results) for every PNG that FLIP compares.
+R=("$NBVH" render "$SCENE" --camera "$CAM" --env "$ENV" --env-rotation 285 --width 1920 --height 1080 --max-depth 8
+   --exposure "${EXPOSURE:-0}")
 t0=$(date +%s)
 # shellcheck disable=SC2086
 "$NBVH" train "$SCENE" --backend cuda ${TRAIN_ARGS:-} --out "$OUT/chess.nbvh" 2>&1 | grep -v "^step " >> "$S"
