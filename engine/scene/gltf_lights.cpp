@@ -53,10 +53,11 @@ std::optional<PunctualLight> node_light(const tinygltf::Model& model, const tiny
     }
     if (src.color.size() == 3) {
         const glm::dvec3 c(src.color[0], src.color[1], src.color[2]);
-        if (finite(c) && c.x >= 0.0 && c.y >= 0.0 && c.z >= 0.0)
+        if (finite(c) && c.x >= 0.0 && c.y >= 0.0 && c.z >= 0.0 &&
+            glm::all(glm::lessThan(c, glm::dvec3(1.0e30))))
             l.color = glm::vec3(c);
         else
-            log_warn("%s: colour is not in [0, inf)^3; white used", what.c_str());
+            log_warn("%s: colour is not in [0, 1e30)^3; white used", what.c_str());
     } else if (!src.color.empty()) {
         log_warn("%s: colour does not have 3 components; white used", what.c_str());
     }
@@ -68,35 +69,37 @@ std::optional<PunctualLight> node_light(const tinygltf::Model& model, const tiny
     l.intensity = float(src.intensity);
     if (l.type != LightType::directional && src.range != 0.0) {
         // Spec: range > 0 when defined; 0 is tinygltf's "absent" (infinite).
-        if (std::isfinite(src.range) && src.range > 0.0)
-            l.range = float(src.range);
+        if (std::isfinite(src.range) && src.range > 0.0 && src.range < 1.0e30)
+            l.range = std::max(float(src.range), 1.0e-30f);
         else
-            log_warn("%s: range %g is not positive; the light has infinite range", what.c_str(), src.range);
+            log_warn("%s: range %g is not a positive number below 1e30; the light has infinite range",
+                     what.c_str(), src.range);
     }
     if (l.type == LightType::spot) {
-        double inner = src.spot.innerConeAngle, outer = src.spot.outerConeAngle;
-        if (!std::isfinite(inner) || !std::isfinite(outer) || inner < 0.0 || outer > HALF_PI ||
-            inner >= outer || outer <= 0.0) {
-            const double o2 = std::isfinite(outer) ? std::clamp(outer, 1.0e-4, HALF_PI) : HALF_PI / 2.0;
-            const double i2 = std::isfinite(inner) ? std::clamp(inner, 0.0, o2 * 0.999) : 0.0;
+        const double inner = src.spot.innerConeAngle, outer = src.spot.outerConeAngle;
+        // Kept in float: the outer cone at least 1e-4 rad, the inner one strictly inside it.
+        const float o =
+            std::isfinite(outer) ? float(std::clamp(outer, 1.0e-4, HALF_PI)) : float(HALF_PI / 2.0);
+        const float i = std::isfinite(inner) ? std::clamp(float(inner), 0.0f, o * 0.999f) : 0.0f;
+        if (!(inner >= 0.0 && inner < outer && outer <= HALF_PI))
             log_warn("%s: cone angles inner %g, outer %g outside 0 <= inner < outer <= pi/2; using %g, %g",
-                     what.c_str(), inner, outer, i2, o2);
-            inner = i2;
-            outer = o2;
-        }
-        l.inner_cone = float(inner);
-        l.outer_cone = float(outer);
+                     what.c_str(), inner, outer, double(i), double(o));
+        l.inner_cone = i;
+        l.outer_cone = o;
     }
     // Position: the node's origin; direction: its -z axis (lights point down -z, the extension spec).
+    // Beyond 1e9 m (the loader's world-coordinate limit for geometry) float products overflow.
     const glm::dvec3 p(world[3]);
     const glm::dvec3 d = -glm::dvec3(world[2]);
     const double dl = glm::length(d);
-    if (!finite(p) || !(dl > 0.0) || !std::isfinite(dl)) {
-        log_warn("%s: the node's transform is degenerate or non-finite; light ignored", what.c_str());
+    if (!finite(p) || glm::any(glm::greaterThan(glm::abs(p), glm::dvec3(1.0e9))) || !(dl > 0.0) ||
+        !std::isfinite(dl)) {
+        log_warn("%s: the node's transform is degenerate, non-finite or beyond 1e9 m; light ignored",
+                 what.c_str());
         return std::nullopt;
     }
     l.position = glm::vec3(p);
-    l.direction = glm::vec3(d / dl);
+    l.direction = glm::normalize(glm::vec3(d / dl));
     return l;
 }
 

@@ -81,6 +81,15 @@ void check_scene(const Scene& s) {
     }
     const Aabb b = s.world_bounds();
     NBVH_CHECK(b.empty() || (finite(b.lo) && finite(b.hi)));
+    // gltf_lights.h: finite placement, unit direction, non-negative finite colour, intensity and range,
+    // ordered cone angles.
+    for (const PunctualLight& l : s.lights) {
+        NBVH_CHECK(finite(l.position) && finite(l.direction) && std::fabs(glm::length(l.direction) - 1.0f) < 1e-3f);
+        NBVH_CHECK(finite(l.color) && l.color.x >= 0.0f && l.color.y >= 0.0f && l.color.z >= 0.0f);
+        NBVH_CHECK(std::isfinite(l.intensity) && l.intensity >= 0.0f && std::isfinite(l.range) && l.range >= 0.0f);
+        NBVH_CHECK(l.type != LightType::spot || (l.inner_cone >= 0.0f && l.inner_cone < l.outer_cone &&
+                                                 l.outer_cone <= 1.5708f));
+    }
 }
 
 // A directory of this process for the input file, removed at exit.

@@ -151,6 +151,29 @@ def skin_morph():
                                                                        "targets": [{"POSITION": delta}]}]}]})
 
 
+def lights():
+    # KHR_lights_punctual: a point light with range and colour, a spot under a scaled parent, a directional
+    # light; a single-sided quad (back faces culled) under them.
+    b = Builder()
+    pos = b.vec3(QUAD)
+    idx = b.add("H", [0, 1, 2, 0, 2, 3], 5123, "SCALAR", 34963)
+    return b.doc({
+        "scene": 0, "scenes": [{"nodes": [0, 1, 2, 4]}],
+        "nodes": [{"name": "quad", "mesh": 0},
+                  {"name": "bulb", "translation": [0.5, 0.5, 1], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+                  {"name": "rig", "scale": [2, 2, 2], "children": [3]},
+                  {"name": "spot", "translation": [0, 0, 2], "extensions": {"KHR_lights_punctual": {"light": 1}}},
+                  {"name": "sun", "rotation": [-0.3826834, 0, 0, 0.9238795],
+                   "extensions": {"KHR_lights_punctual": {"light": 2}}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}, "indices": idx, "material": 0}]}],
+        "materials": [{"name": "single", "doubleSided": False}],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "point", "color": [1, 0.9, 0.8], "intensity": 20, "range": 4},
+            {"type": "spot", "intensity": 50, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.6}},
+            {"type": "directional", "intensity": 3, "name": "sun"}]}},
+        "extensionsUsed": ["KHR_lights_punctual"]})
+
+
 def glb(doc_builder):
     d = doc_builder()
     raw = base64.b64decode(d["buffers"][0]["uri"].split(",", 1)[1])
@@ -169,6 +192,7 @@ def main():
              "valid_textured_quad.gltf": json.dumps(textured(), indent=1).encode(),
              "valid_neural_scene.gltf": json.dumps(neural_scene(), indent=1).encode(),
              "valid_skin_morph.gltf": json.dumps(skin_morph(), indent=1).encode(),
+             "valid_lights.gltf": json.dumps(lights(), indent=1).encode(),
              "valid_material_quad.glb": glb(material_quad)}
     for name, data in files.items():
         with open(os.path.join(OUT, name), "wb") as f:
