@@ -131,11 +131,16 @@ struct Frame {
     int validation = 0;
 };
 
-Frame render_frame(const Scene& scene, const NeuralModel* model) {
+// lavapipe with validation on.
+vk::ContextOptions lavapipe() {
     vk::ContextOptions co;
     co.device = vk::DeviceChoice::cpu;
     co.validation = true;
-    vk::Context ctx(co);
+    return co;
+}
+
+Frame render_frame(const Scene& scene, const NeuralModel* model) {
+    vk::Context ctx(lavapipe());
     const SceneAccel accel = build_scene_accel(scene);
     RenderOptions o;
     o.width = o.height = SIZE;
@@ -271,10 +276,7 @@ TEST(MultiAsset, SettingsApplyWithoutRebuildMatchFreshRenderers) {
     const Trained& t = trained();
     Scene scene = make_scene();
     bind_model_to_scene(scene, t.model, "m.nbvh");
-    vk::ContextOptions co;
-    co.device = vk::DeviceChoice::cpu;
-    co.validation = true;
-    vk::Context ctx(co);
+    vk::Context ctx(lavapipe());
     const SceneAccel accel = build_scene_accel(scene);
     RenderOptions o;
     o.width = o.height = 48;
