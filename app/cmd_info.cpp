@@ -30,12 +30,7 @@ std::string utc_date(int64_t unix_seconds) {
     return buf;
 }
 
-// Classical representation of the replaced mesh as the renderer holds it: positions, normals and
-// one UV set per vertex (32 B), 3 indices per triangle (12 B), and a BLAS of ~one 64-byte node per
-// triangle (two-child nodes over leaves of up to 2 triangles, rounded up).
-uint64_t classical_bytes(const TrainingMetadata& m) {
-    return m.source_vertices * 32 + m.source_triangles * 12 + m.source_triangles * sizeof(GpuBvhNode);
-}
+uint64_t classical_bytes(const TrainingMetadata& m) { return mesh_and_blas_bytes(m.source_triangles, m.source_vertices); }
 
 void print_model(const std::string& path) {
     const NeuralModel m = load_model(path);

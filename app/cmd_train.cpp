@@ -21,6 +21,7 @@
 #include "engine/neural/asset_table.h"
 #include "engine/neural/model_file.h"
 #include "engine/scene/gltf_loader.h"
+#include "trainer/compact_hash.h"
 #include "engine/scene/scene_stats.h"
 #include "trainer/evaluation.h"
 #include "trainer/model_export.h"
@@ -104,7 +105,13 @@ void run_train(const TrainArgs& a) {
         pick_neural_mesh(scene); // throws the "no neural asset" message
     }
     const TrainingAsset asset = make_training_asset(scene, meshes);
-    if (a.deterministic) setenv("NBVH_CUDA_DETERMINISTIC", "1", 1); // read by the CUDA backend
+    if (!a.hash_log2) { // compact default (trainer/compact_hash.h): the grid <= 1/5 of the geometry
+        const uint32_t max_log2 = opt.network.log2_hash_size;
+        opt.network.log2_hash_size = compact_hash_log2(asset, opt.network, max_log2);
+        if (opt.network.log2_hash_size < max_log2)
+            log_info("hash 2^%u (compact default: the grid at most 1/5 of the mesh + BLAS it replaces; --hash-log2 %u "
+                     "for the backend's maximum)", opt.network.log2_hash_size, max_log2);
+    }
     std::unique_ptr<TrainerBackend> be = make_backend(backend, asset, opt);
     const SplitSchedule schedule = make_split_schedule(opt);
     log_info("training %s (%u triangles) on %s: %u steps x %u rays, target %u nodes, hash 2^%u, %u LoD(s); %s",
@@ -150,7 +157,7 @@ void add_train_command(CLI::App& app) {
     cmd->add_option("--out,-o", args->out, "output model (default: SCENE.nbvh in the current directory)");
     cmd->add_option("--backend", args->backend, "cpu, cuda or auto (default: auto = cuda when a GPU is usable)");
     cmd->add_option("--nodes", args->nodes, "target N-BVH node count (CPU default 1000, CUDA 2395)");
-    cmd->add_option("--hash-log2", args->hash_log2, "log2 of the hash-table entries per level (CPU 15, CUDA 18)");
+    cmd->add_option("--hash-log2", args->hash_log2, "log2 of the hash-table entries per level (default: compact, the largest up to CPU 15 / CUDA 18 whose grid is at most 1/5 of the replaced mesh + BLAS)");
     cmd->add_option("--steps", args->steps, "optimiser steps (CPU default 1000, CUDA 10000)");
     cmd->add_option("--batch", args->batch, "rays per step (CPU default 2048, CUDA 262144)");
     cmd->add_option("--lods", args->lods, "cuts kept as levels of detail (1..8)");

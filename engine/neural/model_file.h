@@ -92,6 +92,13 @@ NeuralModel load_model(const std::filesystem::path& path);
 // grid, level table), in bytes.
 uint64_t model_gpu_bytes(const NeuralModel& model);
 
+// The classical representation of a mesh as the renderer holds it: positions, normals and one UV set
+// per vertex (32 B), 3 indices per triangle (12 B), and a BLAS of ~one 64-byte node per triangle
+// (two-child nodes over leaves of up to 2 triangles, rounded up).
+inline uint64_t mesh_and_blas_bytes(uint64_t triangles, uint64_t vertices) {
+    return vertices * 32 + triangles * 12 + triangles * sizeof(GpuBvhNode);
+}
+
 // The official implementation's tree file (madmann91 bvh v2 dump, notes §10): detection and import of
 // its node list. Imported nodes have lod_count 1 (childless nodes are leaves, code 1 = final leaf);
 // base_node is BVH_INVALID. Throws nbvh::Error on anything malformed.
