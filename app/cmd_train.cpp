@@ -8,7 +8,6 @@
 // N-BVH leaf; splits are ranked jointly over all assets by the paper's r = 2 log q + log p (rays are
 // drawn uniformly over the assets, each asset normalised to the same atlas size), so nodes go where the
 // error is, as in the paper's single merged tree.
-#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -21,8 +20,8 @@
 #include "engine/neural/asset_table.h"
 #include "engine/neural/model_file.h"
 #include "engine/scene/gltf_loader.h"
-#include "trainer/compact_hash.h"
 #include "engine/scene/scene_stats.h"
+#include "trainer/compact_hash.h"
 #include "trainer/evaluation.h"
 #include "trainer/model_export.h"
 #include "trainer/progress_bar.h"
@@ -63,6 +62,7 @@ void run_train(const TrainArgs& a) {
     opt.lods = a.lods;
     opt.seed = a.seed;
     opt.threads = a.threads;
+    opt.deterministic = a.deterministic;
     validate(opt);
     // Output paths are checked before the (minutes-long) training, and never replace the input scene.
     const std::string out = a.out.empty()

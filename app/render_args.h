@@ -11,7 +11,8 @@
 namespace nbvh::app {
 
 // Adds --width --height --spp --max-depth --seed --wave-pixels and the neural material/round flags
-// (--neural-roughness --neural-metallic --neural-max-leaves --neural-batched-rounds), writing into `o`
+// (--neural-roughness --neural-metallic --neural-max-leaves --neural-batched-rounds
+// --neural-leaves-per-round), writing into `o`
 // (which must outlive the parse).
 void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o);
 

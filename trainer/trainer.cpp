@@ -96,7 +96,8 @@ std::unique_ptr<TrainerBackend> make_backend(BackendChoice choice, const Trainin
     if (choice == BackendChoice::cuda) {
 #if defined(NBVH_HAVE_CUDA)
         if (!cuda_backend_available()) throw Error("--backend cuda: no usable CUDA GPU was found");
-        return make_cuda_backend(asset, options.network, make_adam_config(options), options.seed);
+        return make_cuda_backend(asset, options.network, make_adam_config(options), options.seed,
+                                 options.deterministic);
 #else
         throw Error("--backend cuda: this build has no CUDA backend (nvcc was not found at configure time)");
 #endif
@@ -108,17 +109,21 @@ std::unique_ptr<TrainerBackend> make_backend(BackendChoice choice, const Trainin
 
 namespace {
 
-// Error statistics of one N-BVH node since its creation (notes §7).
+// Error statistics of one N-BVH node since its creation (notes §7), over the steps that trained.
 struct NodeStats {
     double loss_sum = 0.0;
     uint64_t samples = 0;
-    uint64_t draws = 0;
-    uint64_t steps_alive = 0;
-    // h = q sqrt(p), q = loss/samples, p = draws/steps: ranks like r = 2 log q + log p (paper §3.2).
+    uint64_t draws = 0;  // rays of the current cut whose first leaf this was (before the roulette)
+    double rays = 0.0;   // rays drawn for the current cut while the node was a leaf
+    // h = q sqrt(p), q = loss/samples, p = draws/rays: ranks like r = 2 log q + log p (paper §3.2).
+    // p is the probability that a training ray meets this leaf first. Rejected samples are redrawn, so
+    // the rays drawn per step grow as the roulette rejects more (up to 1/0.005 times): draws per step
+    // alive (the official p, whose batches have no redraws) would rank a leaf that lived through cheap
+    // steps below a newer one of half its probability.
     double heuristic() const {
-        if (samples == 0 || steps_alive == 0) return -1.0;
+        if (samples == 0 || rays <= 0.0) return -1.0;
         const double q = loss_sum / double(samples);
-        const double p = double(draws) / double(steps_alive);
+        const double p = double(draws) / rays;
         return q * std::sqrt(p);
     }
 };
@@ -218,14 +223,17 @@ TrainResult train_asset(const TrainingAsset& asset, const TrainOptions& options,
             consecutive_skips = 0;
             trained_samples += st.samples;
             NBVH_CHECK(st.leaves.size() == cut0_nodes.size());
+            // Every draw picks its cut uniformly (paper §3.4), so the current cut got st.draws / cuts
+            // of the rays drawn in expectation, misses and rejected samples included.
+            const double cut0_rays = double(st.draws) / double(params.cuts.size());
             for (size_t i = 0; i < cut0_nodes.size(); ++i) {
                 NodeStats& ns = stats[cut0_nodes[i]];
                 ns.loss_sum += st.leaves[i].loss_sum;
                 ns.samples += st.leaves[i].samples;
                 ns.draws += st.leaves[i].draws;
+                ns.rays += cut0_rays;
             }
         }
-        for (uint32_t n : cut0_nodes) stats[n].steps_alive++;
 
         // Splits after the optimiser step (split_scheduler.h contract), capped at the target.
         bool changed = false;

@@ -36,6 +36,7 @@ struct TrainOptions {
     float learning_rate = 1e-2f;       // Adam (paper §4)
     float final_lr_factor = 0.1f;      // lr at the end of the final stage, relative
     uint32_t threads = 0;              // CPU backend threads (0 = all cores)
+    bool deterministic = false;        // CUDA backend: bit-reproducible steps (--deterministic; the CPU always is)
     uint32_t max_consecutive_skips = 50; // then training fails with nbvh::Error
 };
 

@@ -29,8 +29,9 @@ struct LossTerms {
 };
 
 // Per leaf of the current cut, accumulated over one step. The host sums these from the node's
-// creation: q = loss_sum / samples (mean loss of a trained sample), p = draws / steps alive (how often
-// a training ray meets the leaf first, measured before the survival roulette).
+// creation: q = loss_sum / samples (mean loss of a trained sample), p = draws / rays drawn for the
+// current cut (StepStats::draws / cuts): the probability that a training ray meets the leaf first,
+// measured before the survival roulette.
 struct LeafStepStats {
     double loss_sum = 0.0;  // weighted total loss of the samples trained in this leaf
     uint32_t samples = 0;   // samples that survived the roulette and were trained
@@ -83,8 +84,10 @@ std::unique_ptr<TrainerBackend> make_cpu_backend(const TrainingAsset& asset, con
 #if defined(NBVH_HAVE_CUDA)
 // trainer/cuda/ (built when nvcc is found). cuda_backend_available() is false without a usable GPU.
 bool cuda_backend_available();
+// deterministic: order-independent gradient sums, bit-reproducible steps (trainer/cuda/README.md).
 std::unique_ptr<TrainerBackend> make_cuda_backend(const TrainingAsset& asset, const NeuralConfig& config,
-                                                  const neural::AdamConfig& adam, uint64_t seed);
+                                                  const neural::AdamConfig& adam, uint64_t seed,
+                                                  bool deterministic = false);
 #endif
 
 } // namespace nbvh

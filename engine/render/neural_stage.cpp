@@ -14,16 +14,9 @@
 namespace nbvh::render {
 
 uint32_t effective_leaves_per_round(const NeuralRenderOptions& o) {
-    uint32_t k = o.leaves_per_round;
-    if (const char* env = std::getenv("NBVH_NEURAL_LEAVES_PER_ROUND"); env && *env) {
-        char* end = nullptr;
-        const unsigned long v = std::strtoul(env, &end, 10);
-        if (*end != '\0' || v == 0 || v > NB_NL_MAX_LEAVES_PER_ROUND)
-            throw Error(strfmt("NBVH_NEURAL_LEAVES_PER_ROUND must be in 1..%u", NB_NL_MAX_LEAVES_PER_ROUND));
-        k = uint32_t(v);
-    }
+    const uint32_t k = o.leaves_per_round;
     if (k == 0 || k > NB_NL_MAX_LEAVES_PER_ROUND)
-        throw Error(strfmt("neural leaves per round must be in 1..%u", NB_NL_MAX_LEAVES_PER_ROUND));
+        throw Error(strfmt("--neural-leaves-per-round must be in 1..%u", NB_NL_MAX_LEAVES_PER_ROUND));
     return k;
 }
 

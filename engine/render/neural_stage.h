@@ -46,13 +46,12 @@ struct NeuralRenderOptions {
     uint32_t batched_rounds = 256;
     // Leaves a ray queues per round (1..NB_NL_MAX_LEAVES_PER_ROUND): the next ones in key order in front
     // of its best hit, so one traversal and one query round serve several leaf visits (the extra ones
-    // are speculative: their hits cannot beat the closest, same image). The environment variable
-    // NBVH_NEURAL_LEAVES_PER_ROUND overrides it (benchmarks).
+    // are speculative: their hits cannot beat the closest, same image). --neural-leaves-per-round.
     uint32_t leaves_per_round = 4;
     float threshold = NB_VISIBILITY_THRESHOLD;
 };
 
-// Leaves per round after the NBVH_NEURAL_LEAVES_PER_ROUND override (throws nbvh::Error when out of range).
+// Leaves per round of `options` (throws nbvh::Error when out of range).
 uint32_t effective_leaves_per_round(const NeuralRenderOptions& options);
 
 // Throws nbvh::Error on out-of-range constants (roughness/metallic outside [0,1], rounds 0 or > 256,

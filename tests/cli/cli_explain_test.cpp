@@ -52,12 +52,12 @@ TEST(CliExplain, HybridRenderListsTheNeuralPasses) {
 }
 
 TEST(CliExplain, LeavesPerRoundComeFromTheRenderersStage) {
-    // The benchmark override of leaves per round is read where the renderer reads it.
-    setenv("NBVH_NEURAL_LEAVES_PER_ROUND", "2", 1);
-    const auto r = run_nbvh(explain({"--model", tiny_model().string()}), 60.0);
-    unsetenv("NBVH_NEURAL_LEAVES_PER_ROUND");
+    // --neural-leaves-per-round reaches the renderer's stage (it was a hidden environment variable).
+    const auto r = run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round", "2"}), 60.0);
     ASSERT_EQ(r.exit_code, 0) << r.describe();
     EXPECT_TRUE(has(r.out, "at most 8, 2 queued per round: 4 batched rounds")) << r.out;
+    const auto bad = run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round", "9"}), 60.0);
+    EXPECT_EQ(check_clean_error(bad, {"--neural-leaves-per-round"}, false), "") << bad.describe();
 }
 
 TEST(CliExplain, ClassicalRendersHaveNoNeuralPasses) {

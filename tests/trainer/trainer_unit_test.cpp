@@ -285,3 +285,75 @@ TEST(TrainingAsset, PartsAreDisjointSubtreesOfTheJoinedBvh) {
         EXPECT_LT(bvh.prim_indices[leaf.first], part.first_triangle + part.triangle_count);
     }
 }
+
+// The hit probability p of the split heuristic (paper §3.2: h = q sqrt(p)) is the probability that a
+// training ray meets the leaf first. The survival roulette redraws rejected samples, so the rays drawn
+// per step grow as the roulette rejects more; p must not count that growth (draws / steps alive did:
+// a leaf that lived through cheap steps looked rarer than a newer leaf of half its true probability).
+// A scripted backend: root -> A, B (A has the larger error and is split next) -> A1, A2, B, with true
+// probabilities A1 = A2 = 1/4, B = 1/2 and ten times more rays drawn per step once A is split. With an
+// unbiased p and equal q, keep(B) = 1 and keep(A1) = keep(A2) = sqrt(1/2) at every step after that.
+namespace {
+class ScriptedBackend final : public TrainerBackend {
+public:
+    const char* name() const override { return "scripted"; }
+    StepStats step(const StepParams& params) override {
+        const TrainingCut& cut = *params.cuts[0];
+        StepStats st;
+        st.leaves.resize(cut.size());
+        auto set = [&](size_t slot, uint32_t draws, double loss_per_sample) {
+            st.leaves[slot].draws = draws;
+            st.leaves[slot].samples = std::max(1u, draws / 10);
+            st.leaves[slot].loss_sum = loss_per_sample * st.leaves[slot].samples;
+            st.draws += draws;
+            st.samples += st.leaves[slot].samples;
+        };
+        if (cut.size() == 1) {
+            set(0, 100, 1.0);
+        } else if (cut.size() == 2) {
+            a_ = cut.leaves[0];
+            b_ = cut.leaves[1];
+            two_leaf_steps++;
+            set(0, 50, 2.0); // A: larger error, split next
+            set(1, 50, 1.0);
+        } else {
+            three_leaf_steps++;
+            for (size_t i = 0; i < cut.size(); ++i) {
+                const bool b = cut.leaves[i] == b_;
+                if (b) b_slot = int(i);
+                set(i, b ? 500 : 250, 1.0); // 10x the rays drawn per step
+            }
+            if (three_leaf_steps >= 2) keeps.push_back(cut.keep_probability); // A1/A2 have statistics
+        }
+        st.loss.total = 1.0;
+        return st;
+    }
+    void read_weights(neural::NetworkWeights& out) const override { out = {}; }
+
+    uint32_t two_leaf_steps = 0, three_leaf_steps = 0;
+    int b_slot = -1;
+    std::vector<std::vector<float>> keeps;
+
+private:
+    uint32_t a_ = 0, b_ = 0;
+};
+} // namespace
+
+TEST(Trainer, HitProbabilityIsUnbiasedByRedraws) {
+    const Scene scene = test::scene_of(test::height_field(16, 0.2f, 1.0f, glm::vec3(0.0f)));
+    const TrainingAsset asset = make_training_asset(scene, 0);
+    TrainOptions o = default_train_options(BackendChoice::cpu);
+    o.steps = 400;
+    o.target_nodes = 5;
+    ScriptedBackend backend;
+    const TrainResult r = train_asset(asset, o, backend);
+    EXPECT_EQ(r.tree.node_count(), 5u);
+    ASSERT_GE(backend.two_leaf_steps, 3u);
+    ASSERT_FALSE(backend.keeps.empty());
+    ASSERT_GE(backend.b_slot, 0);
+    for (const std::vector<float>& keep : backend.keeps) {
+        ASSERT_EQ(keep.size(), 3u);
+        for (size_t i = 0; i < 3; ++i)
+            EXPECT_NEAR(keep[i], int(i) == backend.b_slot ? 1.0f : std::sqrt(0.5f), 1e-4f) << i;
+    }
+}

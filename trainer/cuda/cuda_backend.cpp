@@ -137,8 +137,7 @@ public:
         c.rel_l2_eps = NB_REL_L2_EPS;
         c.normal_scale = NB_NORMAL_LINEAR_SCALE;
         c.normal_offset = NB_NORMAL_LINEAR_OFFSET;
-        const char* env = std::getenv("NBVH_CUDA_DETERMINISTIC");
-        c.deterministic = options.deterministic || (env && std::strcmp(env, "1") == 0);
+        c.deterministic = options.deterministic;
         c.loss_scale = options.loss_scale;
         if (!(c.loss_scale >= 1.0f && c.loss_scale <= 65536.0f)) throw Error("CUDA loss scale must be in [1, 65536]");
         try {
@@ -255,8 +254,10 @@ std::unique_ptr<CudaTrainerBackend> make_cuda_backend_ex(const TrainingAsset& as
 }
 
 std::unique_ptr<TrainerBackend> make_cuda_backend(const TrainingAsset& asset, const NeuralConfig& config,
-                                                  const neural::AdamConfig& adam, uint64_t seed) {
-    return make_cuda_backend_ex(asset, config, adam, CudaBackendOptions{}, seed);
+                                                  const neural::AdamConfig& adam, uint64_t seed, bool deterministic) {
+    CudaBackendOptions options;
+    options.deterministic = deterministic;
+    return make_cuda_backend_ex(asset, config, adam, options, seed);
 }
 
 } // namespace nbvh

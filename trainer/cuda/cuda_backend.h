@@ -17,8 +17,7 @@ namespace nbvh {
 struct CudaBackendOptions {
     // Deterministic mode: grid gradients accumulate in 64-bit fixed point (order-independent integer
     // atomics) instead of fp32 atomics; everything else is already order-fixed. Bit-reproducible
-    // runs for a seed on one GPU model. Also switched on by the environment variable
-    // NBVH_CUDA_DETERMINISTIC=1.
+    // runs for a seed on one GPU model (nbvh train --deterministic, TrainOptions::deterministic).
     bool deterministic = false;
     float loss_scale = 128.0f; // per-sample loss scale of the fp16 backward (halved on overflow)
 };
