@@ -5,7 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 PKGS=(build-essential cmake ninja-build pkg-config git
       libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers glslc glslang-tools
-      libglm-dev libtinygltf-dev libstb-dev libtinyexr-dev nlohmann-json3-dev libcli11-dev
+      libglm-dev libtinygltf-dev libstb-dev libtinyexr-dev nlohmann-json3-dev libcli11-dev libmeshoptimizer-dev
+      python3-matplotlib
       libgtest-dev libglfw3-dev libimgui-dev xvfb xauth)
 missing=()
 for p in "${PKGS[@]}"; do dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p"); done

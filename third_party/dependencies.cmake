@@ -6,6 +6,7 @@ find_package(TinyGLTF REQUIRED)
 find_package(tinyexr REQUIRED)
 find_package(nlohmann_json REQUIRED)
 find_package(CLI11 REQUIRED)
+find_package(meshoptimizer REQUIRED)
 find_package(Threads REQUIRED)
 find_program(NBVH_GLSLC glslc REQUIRED)
 
@@ -17,6 +18,11 @@ target_link_libraries(nbvh_deps INTERFACE Vulkan::Vulkan glm::glm Threads::Threa
 add_library(nbvh_tinygltf INTERFACE)
 add_library(nbvh::tinygltf ALIAS nbvh_tinygltf)
 target_link_libraries(nbvh_tinygltf INTERFACE TinyGLTF::TinyGLTF)
+
+# meshoptimizer (shared library): mesh simplification, the equal-memory baseline of nbvh study
+add_library(nbvh_meshoptimizer INTERFACE)
+add_library(nbvh::meshoptimizer ALIAS nbvh_meshoptimizer)
+target_link_libraries(nbvh_meshoptimizer INTERFACE meshoptimizer::meshoptimizer)
 
 # tinyexr (shared library)
 add_library(nbvh_tinyexr INTERFACE)

@@ -10,6 +10,7 @@
 // is <= 1/4). So: outputs within 2e-3, visibility decisions equal except where the reference is within
 // 2e-3 of the threshold, depth decodes within 2e-3 * (L + pad), normals within 0.01 (their decode
 // divides by |2y - 1|, so rows whose reference |2y - 1| is < 0.05 are skipped).
+#include "engine/render/gpu_memory.h"
 #include "engine/render/neural_model_gpu.h"
 #include "engine/vk/context.h"
 #include "tests/neuralvk/neural_test_model.h"
@@ -96,4 +97,15 @@ TEST(NeuralPath, TransposedWeightsForCooperativeMatrices) {
             for (uint32_t c = 0; c < nb_mlp_layer_inputs(m); ++c)
                 ++hits[nb_mlp_layer_offset(m) + nb_coop_weight_slot(nb_mlp_layer_outputs(m), c, r)];
     EXPECT_EQ(std::count(hits.begin(), hits.end(), 1), std::ptrdiff_t(hits.size()));
+}
+
+// The host-side memory figure (engine/render/gpu_memory.h, what nbvh bench/study report) is what the
+// model's buffers occupy on the device.
+TEST(NeuralMemory, HostFigureMatchesTheUploadedBuffers) {
+    vk::Context ctx = make_lavapipe();
+    const test::TestModel tm = test::make_test_model(3, glm::vec3(-1.0f), glm::vec3(1.0f), 12);
+    const NeuralModelGpu gpu(ctx, tm.model);
+    const NeuralGpuBytes b = neural_gpu_bytes(tm.model);
+    EXPECT_EQ(gpu.bytes(), b.total() - b.assets - b.params);
+    EXPECT_EQ(ctx.validation_message_count(), 0);
 }
