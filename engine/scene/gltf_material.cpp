@@ -39,6 +39,18 @@ struct TextureTable {
     Scene& scene;
     std::map<int, int32_t> image_to_texture; // glTF image -> Scene::textures index (-1 = unusable)
 
+    // The first image with the same source (bufferView, else uri) as `image`: decode_image decoded only
+    // that one.
+    int source_of(int image) const {
+        const tinygltf::Image& img = model.images[size_t(image)];
+        for (int i = 0; i < image; ++i) {
+            const tinygltf::Image& o = model.images[size_t(i)];
+            if ((img.bufferView >= 0 && o.bufferView == img.bufferView) || (img.bufferView < 0 && !img.uri.empty() && o.uri == img.uri))
+                return i;
+        }
+        return image;
+    }
+
     // Resolves a textureInfo (glTF texture index, texCoord, extensions) into a TextureRef.
     TextureRef resolve(int texture_index, int tex_coord, const tinygltf::ExtensionMap& extensions, bool srgb,
                        const std::string& what) {
@@ -53,9 +65,9 @@ struct TextureTable {
             log_warn("%s: texture %d has no usable image source; ignored", what.c_str(), texture_index);
             return ref;
         }
-        auto it = image_to_texture.find(image_index);
+        auto it = image_to_texture.find(source_of(image_index));
         if (it == image_to_texture.end()) {
-            const tinygltf::Image& img = model.images[size_t(image_index)];
+            const tinygltf::Image& img = model.images[size_t(source_of(image_index))];
             int32_t slot = -1;
             const bool ok = img.width > 0 && img.height > 0 && img.component == 4 && img.bits == 8 &&
                             img.image.size() == size_t(img.width) * size_t(img.height) * 4;
@@ -71,7 +83,7 @@ struct TextureTable {
                 log_warn("%s: image %d ('%s') could not be loaded; the material goes without it", what.c_str(),
                          image_index, img.uri.c_str());
             }
-            it = image_to_texture.emplace(image_index, slot).first;
+            it = image_to_texture.emplace(source_of(image_index), slot).first;
         }
         ref.texture = it->second;
         if (ref.texture < 0) return ref;
@@ -116,9 +128,16 @@ bool decode_image(tinygltf::Image* image, int image_index, std::string* /*err*/,
         return true; // not fatal: the material loses this texture
     };
     if (!bytes || size <= 0) return fail("no data");
+    // The same bytes again (images sharing a bufferView): left empty, convert_materials shares the first.
+    if (ctx && !ctx->first_with_bytes.emplace(std::make_pair(bytes, size), image_index).second) return true;
     if (!stbi_info_from_memory(bytes, size, &w, &h, &n)) return fail(std::string("cannot decode: ") + stbi_failure_reason());
     if (w <= 0 || h <= 0 || w > MAX_TEXTURE_EDGE || h > MAX_TEXTURE_EDGE)
         return fail(strfmt("size %dx%d outside 1..%d", w, h, MAX_TEXTURE_EDGE));
+    const uint64_t texel_bytes = uint64_t(w) * uint64_t(h) * 4u;
+    if (ctx && ctx->decoded_bytes + texel_bytes > MAX_DECODED_TEXEL_BYTES)
+        return fail(strfmt("decoding it would exceed %llu GiB of texels for the file",
+                           (unsigned long long)(MAX_DECODED_TEXEL_BYTES >> 30)));
+    if (ctx) ctx->decoded_bytes += texel_bytes;
     unsigned char* pixels = stbi_load_from_memory(bytes, size, &w, &h, &n, 4);
     if (!pixels) return fail(std::string("cannot decode: ") + stbi_failure_reason());
     image->width = w;

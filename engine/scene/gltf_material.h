@@ -1,5 +1,6 @@
 // glTF materials and textures -> nbvh::Material / nbvh::Texture (internal to the glTF loader).
 #pragma once
+#include <map>
 #include <string>
 #include <vector>
 
@@ -15,9 +16,15 @@ namespace nbvh::gltf {
 // State of tinygltf's image callback: we decode with stb_image ourselves so that a broken image is a
 // warning (the material then goes without that texture), never a failed load, and so that textures can
 // be skipped entirely (keep_textures = false: geometry-only loads for the trainer).
+// Images that share their bytes (one bufferView or one uri) are decoded once (convert_materials shares
+// the texture), and all decoded images together stay under a budget: a small file cannot make the loader
+// decode one 8192^2 image many times or hold more than 4 GiB of texels.
+inline constexpr uint64_t MAX_DECODED_TEXEL_BYTES = 4ull << 30;
 struct ImageDecodeContext {
     bool decode = true;
     int failures = 0;
+    uint64_t decoded_bytes = 0;
+    std::map<std::pair<const unsigned char*, int>, int> first_with_bytes; // (data, size) -> image index
 };
 
 // Matches tinygltf::LoadImageDataFunction. Always returns true; failures leave the image empty with a warning.
