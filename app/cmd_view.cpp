@@ -1,8 +1,9 @@
 // nbvh view SCENE [--model M.nbvh] [--env FILE] [--width W --height H] [--device auto|gpu|cpu]
 //                 [--max-depth D] [--lod L] [--secondary-lod L] [--neural GLOB]
-//                 [--screenshot FILE.png] [--frames N] [--hide-ui]
+//                 [--screenshot FILE.png] [--frames N] [--hide-ui] [--script FILE]
 // The interactive viewer (app/viewer/): progressive path tracing in a window with a UI panel.
-// --frames N exits after N frames (headless tests under Xvfb); --screenshot saves the window then.
+// --frames N exits after N frames (headless tests under Xvfb); --screenshot saves the window then;
+// --script FILE drives the viewer from a command file (app/viewer/script.h) and exits at its end.
 #include <memory>
 
 #include "app/commands.h"
@@ -25,12 +26,14 @@ void add_view_command(CLI::App& app) {
     cmd->add_option("--secondary-lod", args->secondary_lod, "initial LoD after the first hit (-1: same as --lod)")
         ->check(CLI::Range(-1, 1 << 20));
     cmd->add_option("--screenshot", args->screenshot, "save the window content as PNG after --frames frames");
-    cmd->add_option("--frames", args->frames, "exit after this many frames (default with --screenshot: 16)")
-        ->check(CLI::Range(1u, 1u << 20));
+    auto* frames = cmd->add_option("--frames", args->frames, "exit after this many frames (default with --screenshot: 16)")
+                       ->check(CLI::Range(1u, 1u << 20));
+    cmd->add_option("--script", args->script, "run the commands of this file (app/viewer/script.h), then exit")
+        ->excludes(frames);
     cmd->add_flag("--hide-ui", args->hide_ui, "start with the UI panel hidden (F1 toggles it)");
     cmd->callback([args] {
         viewer::ViewerArgs a = *args;
-        if (!a.screenshot.empty() && a.frames == 0) a.frames = 16;
+        if (!a.screenshot.empty() && a.frames == 0 && a.script.empty()) a.frames = 16;
         viewer::run_viewer(a);
     });
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>
@@ -53,6 +54,21 @@ Window::Window(int width, int height, const std::string& title) {
         glfwTerminate();
         throw Error("no display available (set DISPLAY or use nbvh render)");
     }
+    glfwSetWindowUserPointer(window_, this); // Dear ImGui's GLFW backend keeps its state elsewhere
+    glfwSetDropCallback(window_, on_drop);
+}
+
+void Window::on_drop(GLFWwindow* window, int count, const char** paths) {
+    auto* self = static_cast<Window*>(glfwGetWindowUserPointer(window));
+    if (!self) return;
+    for (int i = 0; i < count; ++i)
+        if (paths[i]) self->dropped_.emplace_back(paths[i]);
+}
+
+std::vector<std::string> Window::take_dropped() {
+    std::vector<std::string> out;
+    out.swap(dropped_);
+    return out;
 }
 
 Window::~Window() {
@@ -79,7 +95,8 @@ void Window::framebuffer_size(uint32_t* width, uint32_t* height) const {
 
 // --- Presenter ----------------------------------------------------------------------------------
 
-Presenter::Presenter(const vk::Context& ctx, const Window& window) : ctx_(ctx), window_(window), display_(ctx) {
+Presenter::Presenter(const vk::Context& ctx, const Window& window)
+    : ctx_(ctx), window_(window), display_(ctx), display_right_(ctx) {
     NBVH_VK_CHECK(glfwCreateWindowSurface(ctx_.instance(), window_.handle(), nullptr, &surface_));
     VkBool32 supported = VK_FALSE;
     NBVH_VK_CHECK(vkGetPhysicalDeviceSurfaceSupportKHR(ctx_.physical_device(), ctx_.queue_family(), surface_, &supported));
@@ -269,6 +286,8 @@ void Presenter::ensure_film_image(uint32_t width, uint32_t height) {
     NBVH_VK_CHECK(vkAllocateMemory(ctx_.device(), &ai, nullptr, &film_memory_));
     NBVH_VK_CHECK(vkBindImageMemory(ctx_.device(), film_image_, film_memory_, 0));
     packed_ = vk::Buffer(ctx_, uint64_t(width) * height * 4, vk::MemoryKind::device, 0, "viewer film bytes");
+    packed_right_ = vk::Buffer();
+    upload_ = vk::Buffer();
     film_width_ = width;
     film_height_ = height;
 }
@@ -279,6 +298,8 @@ void Presenter::destroy_film_image() {
     film_image_ = VK_NULL_HANDLE;
     film_memory_ = VK_NULL_HANDLE;
     packed_ = vk::Buffer();
+    packed_right_ = vk::Buffer();
+    upload_ = vk::Buffer();
 }
 
 bool Presenter::draw(const FilmSource& film, const std::function<void(VkCommandBuffer)>& ui, Screenshot* shot) {
@@ -311,14 +332,42 @@ bool Presenter::draw(const FilmSource& film, const std::function<void(VkCommandB
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     NBVH_VK_CHECK(vkBeginCommandBuffer(cmd_, &bi));
     const VkPipelineStageFlags T = VK_PIPELINE_STAGE_TRANSFER_BIT;
-    // Linear film -> display bytes (compute) -> film image.
-    display_.record(cmd_, *film.linear, packed_, width * height, film.exposure, film.tone_map);
+    // Linear film -> display bytes (compute) -> film image; or the host's bytes -> film image.
+    const uint32_t split = film.linear_right ? std::min(film.split_column, width) : width;
+    VkBuffer left = packed_.handle();
+    if (film.rgba8) {
+        NBVH_CHECK(film.rgba8->size() == size_t(width) * height);
+        if (!upload_)
+            upload_ = vk::Buffer(ctx_, uint64_t(width) * height * 4, vk::MemoryKind::host, 0, "viewer host bytes");
+        std::memcpy(upload_.mapped(), film.rgba8->data(), film.rgba8->size() * 4);
+        left = upload_.handle();
+    } else {
+        display_.record(cmd_, *film.linear, packed_, width * height, film.exposure, film.tone_map);
+        if (split < width) {
+            if (!packed_right_)
+                packed_right_ = vk::Buffer(ctx_, uint64_t(width) * height * 4, vk::MemoryKind::device, 0,
+                                           "viewer right film bytes");
+            display_right_.record(cmd_, *film.linear_right, packed_right_, width * height, film.exposure,
+                                  film.tone_map);
+        }
+    }
     image_barrier(cmd_, film_image_, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, T, 0, T,
                   VK_ACCESS_TRANSFER_WRITE_BIT);
+    // Columns [0, split) from the left bytes, [split, width) from the right film's (same row pitch).
     VkBufferImageCopy copy{};
+    copy.bufferRowLength = width;
     copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    copy.imageExtent = {width, height, 1};
-    vkCmdCopyBufferToImage(cmd_, packed_.handle(), film_image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+    if (film.rgba8 || split > 0) {
+        copy.imageExtent = {film.rgba8 ? width : split, height, 1};
+        vkCmdCopyBufferToImage(cmd_, left, film_image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+    }
+    if (!film.rgba8 && split < width) {
+        copy.bufferOffset = uint64_t(split) * 4;
+        copy.imageOffset = {int32_t(split), 0, 0};
+        copy.imageExtent = {width - split, height, 1};
+        vkCmdCopyBufferToImage(cmd_, packed_right_.handle(), film_image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                               &copy);
+    }
     image_barrier(cmd_, film_image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, T,
                   VK_ACCESS_TRANSFER_WRITE_BIT, T, VK_ACCESS_TRANSFER_READ_BIT);
     // Swapchain image: clear (letterbox bars), then the film scaled to fit with its aspect kept.

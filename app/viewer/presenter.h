@@ -39,9 +39,13 @@ public:
     void request_close();
     void set_title(const std::string& title);
     void framebuffer_size(uint32_t* width, uint32_t* height) const;
+    // Paths of files dropped on the window since the last call (GLFW drop callback).
+    std::vector<std::string> take_dropped();
 
 private:
+    static void on_drop(GLFWwindow* window, int count, const char** paths);
     GLFWwindow* window_ = nullptr;
+    std::vector<std::string> dropped_;
 };
 
 // 8-bit RGB pixels read back from the window (for --screenshot), rows top to bottom.
@@ -50,12 +54,16 @@ struct Screenshot {
     std::vector<uint8_t> rgb;
 };
 
-// What a frame shows: the renderer's linear output on the GPU (WavefrontRenderer::output()).
+// What a frame shows: the renderer's linear output on the GPU (WavefrontRenderer::output()); in the
+// split view a second film right of a column; in the difference and FLIP views bytes made on the host.
 struct FilmSource {
     const vk::Buffer* linear = nullptr; // width*height RGBA32F pixels, rows top to bottom
     uint32_t width = 0, height = 0;
     float exposure = 0.0f;              // stops
     ToneMap tone_map = ToneMap::aces;   // as nbvh render's PNGs
+    const vk::Buffer* linear_right = nullptr; // split view: columns >= split_column come from this film
+    uint32_t split_column = 0;
+    const std::vector<uint32_t>* rgba8 = nullptr; // shown instead of the films (display-pass packing)
 };
 
 class Presenter {
@@ -102,6 +110,9 @@ private:
     uint32_t film_width_ = 0, film_height_ = 0;
     vk::Buffer packed_;   // RGBA8 film bytes, written by the display pass
     DisplayPass display_;
+    vk::Buffer packed_right_; // the split view's right film, by its own pass (one descriptor set each)
+    DisplayPass display_right_;
+    vk::Buffer upload_;   // host bytes (difference / FLIP views)
     vk::Buffer readback_; // host-visible swapchain copy (screenshots)
 
     VkCommandPool pool_ = VK_NULL_HANDLE;

@@ -1,7 +1,9 @@
 #include "app/viewer/ui_panel.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cstdlib>
+#include <string>
 
 #include <imgui.h>
 
@@ -16,6 +18,64 @@ int lod_for_node_count(const std::vector<uint32_t>& counts, uint32_t nodes) {
     }
     return best;
 }
+
+namespace {
+
+// Compare views: hybrid | classical split, difference, FLIP (a classical reference renders beside).
+void draw_compare_section(ViewSettings& s, const PanelInfo& info, PanelActions& act) {
+    ImGui::Separator();
+    ImGui::TextUnformatted("compare with the classical reference");
+    int mode = int(s.view);
+    const char* modes[] = {"image", "split (hybrid | classical)", "difference", "FLIP"};
+    if (ImGui::Combo("view", &mode, modes, 4)) {
+        s.view = ViewMode(mode);
+        act.rebuild = true;
+    }
+    if (s.view == ViewMode::split) ImGui::SliderFloat("split", &s.split, 0.0f, 1.0f, "%.2f (or drag the line)");
+    if (s.view == ViewMode::difference) ImGui::SliderFloat("gain", &s.gain, 1.0f, 64.0f, "x%.0f");
+    if (s.view != ViewMode::image) {
+        ImGui::SliderInt("compare every", &s.compare_every, 1, 240, "%d frames");
+        ImGui::Text("classical %u spp, %.1f ms/frame", info.reference_samples, info.reference_frame_ms);
+        if (info.flip_mean >= 0.0)
+            ImGui::Text("FLIP %.4f (hybrid %u spp vs classical %u spp)", info.flip_mean, info.flip_samples,
+                        info.flip_reference_samples);
+    }
+}
+
+// Live training (live_training.h): options, start / pause / stop, progress, loss plot, save.
+void draw_training_section(ViewSettings& s, const PanelInfo& info, PanelActions& act) {
+    ImGui::Separator();
+    if (!ImGui::TreeNode("live training")) return;
+    const bool active = info.train_state == "running" || info.train_state == "paused";
+    ImGui::BeginDisabled(active);
+    ImGui::SliderInt("steps", &s.train.steps, 10, 20000);
+    ImGui::SliderInt("target nodes", &s.train.nodes, 3, 20000);
+    ImGui::SliderInt("rays / step", &s.train.batch, 256, 1 << 18);
+    ImGui::SliderInt("hash log2", &s.train.hash_log2, 10, 18);
+    ImGui::SliderInt("swap every", &s.train.snapshot_every, 1, 1000, "%d steps");
+    ImGui::EndDisabled();
+    if (!active && ImGui::Button("start")) act.train_start = true;
+    if (active) {
+        if (ImGui::Button(info.train_state == "paused" ? "resume" : "pause")) act.train_pause = true;
+        ImGui::SameLine();
+        if (ImGui::Button("stop")) act.train_stop = true;
+    }
+    if (!info.train_state.empty()) {
+        const float f = info.train_steps ? float(info.train_step) / float(info.train_steps) : 0.0f;
+        ImGui::ProgressBar(f, ImVec2(-1, 0), (std::to_string(info.train_step) + " / " + std::to_string(info.train_steps)).c_str());
+        ImGui::Text("%s: %u nodes, loss %.4f, %u models swapped in, ETA %.0f s", info.train_state.c_str(),
+                    info.train_nodes, info.train_loss, info.train_snapshots, info.train_eta_s);
+        if (!info.train_loss_history.empty())
+            ImGui::PlotLines("loss", info.train_loss_history.data(), int(info.train_loss_history.size()), 0,
+                             nullptr, 0.0f, FLT_MAX, ImVec2(0, 60));
+        ImGui::InputText("file", s.train.save_path.data(), s.train.save_path.size());
+        ImGui::SameLine();
+        if (ImGui::Button("save")) act.train_save = s.train.save_path.data();
+    }
+    ImGui::TreePop();
+}
+
+} // namespace
 
 PanelActions draw_panel(ViewSettings& s, const PanelInfo& info) {
     PanelActions act;
@@ -79,7 +139,14 @@ PanelActions draw_panel(ViewSettings& s, const PanelInfo& info) {
             ImGui::TreePop();
         }
     }
-    if (!info.status.empty()) ImGui::TextWrapped("%s", info.status.c_str());
+    if (info.has_model) draw_compare_section(s, info, act);
+    if (info.can_train) draw_training_section(s, info, act);
+    if (!info.status.empty()) {
+        const bool error = info.status.rfind("error", 0) == 0 || info.status.rfind("not applied", 0) == 0;
+        if (error) ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
+        ImGui::TextWrapped("%s", info.status.c_str());
+        if (error) ImGui::PopStyleColor();
+    }
     ImGui::TextDisabled("left drag orbit, middle/shift drag pan, wheel zoom, WASD/QE fly, F1 UI");
     ImGui::End();
     return act;

@@ -1,6 +1,6 @@
 // nbvh view: the interactive viewer (window + swapchain + Dear ImGui over the wavefront path
-// tracer, accumulating samples progressively; app/README.md). The viewer owns UI state; the
-// renderer is rebuilt when a setting it bakes in changes and told the camera otherwise.
+// tracer, accumulating samples progressively; app/README.md). The viewer owns UI state
+// (viewer_session.h); settings reach the renderer as uploads (WavefrontRenderer::apply).
 #pragma once
 #include <cstdint>
 #include <string>
@@ -20,10 +20,12 @@ struct ViewerArgs {
     std::string screenshot;       // PNG of the window content after `frames` frames
     uint32_t frames = 0;          // > 0: exit after this many frames (headless tests)
     bool hide_ui = false;
+    std::string script;           // command file (script.h); the viewer exits when it ends
 };
 
-// Runs until the window is closed (or `frames` frames). Throws nbvh::Error on user errors (no
-// display, bad scene/model), and when Vulkan validation is on and reported anything.
+// Runs until the window is closed (or `frames` frames, or the script's end). Throws nbvh::Error on
+// user errors (no display, bad scene/model/script), and when Vulkan validation is on and reported
+// anything. Errors after the start (a dropped bad file, a failed training) are shown in the window.
 void run_viewer(const ViewerArgs& args);
 
 } // namespace nbvh::viewer
