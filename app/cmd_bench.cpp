@@ -1,10 +1,13 @@
 // nbvh bench SCENE --model M.nbvh [--width --height --spp --max-depth --seed] [--device auto|gpu|cpu]
 //                  [--repeat R] [--json FILE.json] [--neural-path auto|scalar|coopmat] [--camera] [--env]
-// What accuracy costs in time: in one process on one device, renders the classical reference (neural
-// instances from their triangles, neural material constants: `nbvh render --classical`) and the hybrid
-// image at every level of detail of the model, each timed with GPU timestamps (median of R renders after
-// one warm-up), and scores each hybrid image with LDR-FLIP against the reference. Both images are
-// compared as `nbvh render` writes PNGs (ACES tone map, 8-bit sRGB), i.e. as `nbvh flip a.png b.png`.
+// What accuracy costs in time, quickly: in one process on one device, renders the classical reference
+// (the true scene) and the hybrid image at every level of detail of the model, each timed with GPU
+// timestamps (median of R renders after one warm-up), and scores each hybrid image with LDR-FLIP against
+// the reference (both as `nbvh render` writes PNGs: ACES tone map, 8-bit sRGB). The hybrid renders share
+// the reference's random numbers (same seed and spp), so their FLIP is mostly the neural error; beside it
+// the noise floor (the classical render with another seed vs the reference) says how much of a FLIP
+// noise alone gives at this spp. Converged figures over cameras and configurations: `nbvh study`.
+// Any scene works: the model's asset table decides which instances are neural.
 #include <algorithm>
 #include <cstdio>
 #include <memory>
@@ -15,8 +18,10 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/build_info.h"
 #include "app/output_path.h"
 #include "app/render_args.h"
+#include "app/render_measure.h"
 #include "app/scene_arg.h"
 #include "engine/bvh/scene_accel.h"
 #include "engine/core/error.h"
@@ -24,22 +29,22 @@
 #include "engine/core/image.h"
 #include "engine/core/log.h"
 #include "engine/neural/model_file.h"
+#include "engine/render/gpu_memory.h"
 #include "engine/render/wavefront.h"
 #include "engine/vk/context.h"
-#include "shaders/shared/bvh_node.h"
 
 namespace nbvh::app {
 namespace {
 
 struct BenchArgs {
-    std::string scene, model, device = "auto", json, neural_path = "auto", camera, env;
+    std::string scene, model, device = "auto", json, neural_path = "auto", camera, env, command_line;
     std::optional<float> env_rotation; // degrees
     uint32_t repeat = 3;
     render::RenderOptions options;
     BenchArgs() {
         options.width = 1920;
         options.height = 1080;
-        options.spp = 1;
+        options.spp = 4; // the frame figures of results/ are 4 spp
     }
 };
 
@@ -48,41 +53,14 @@ struct Timed {
     Image image;               // of the last run
 };
 
-// One warm-up render (pipelines, caches, clocks), then `repeat` timed ones; the median by GPU time.
+// One warm-up render, then `repeat` timed ones (render_measure.h); the last image.
 Timed time_renders(const vk::Context& ctx, const Scene& scene, const SceneAccel& accel, const Environment& env,
                    const Camera& camera, const render::RenderOptions& options, uint32_t repeat) {
     render::WavefrontRenderer renderer(ctx, scene, accel, env, camera, options);
-    renderer.render();
-    std::vector<render::RenderStats> runs;
     Timed t;
-    for (uint32_t i = 0; i < repeat; ++i) {
-        render::RenderResult r = renderer.render();
-        runs.push_back(std::move(r.stats));
-        if (i + 1 == repeat) t.image = std::move(r.image);
-    }
-    std::sort(runs.begin(), runs.end(), [](const auto& a, const auto& b) { return a.gpu_ms < b.gpu_ms; });
-    t.stats = runs[runs.size() / 2];
+    t.stats = median_render_stats(renderer, repeat);
+    t.image = renderer.render().image;
     return t;
-}
-
-// The image as `nbvh render` writes it to PNG, decoded back to linear [0,1] (what flip_ldr expects).
-Image as_png_pixels(const Image& linear) {
-    PngEncode enc;
-    enc.tone_map = ToneMap::aces;
-    int channels = 0;
-    const std::vector<uint8_t> px = to_srgb8(linear, enc, &channels);
-    Image out(linear.width, linear.height, 3);
-    for (size_t i = 0; i < linear.pixel_count(); ++i)
-        for (int c = 0; c < 3; ++c) out.data[i * 3 + c] = srgb_to_linear(float(px[i * size_t(channels) + c]) / 255.0f);
-    return out;
-}
-
-// GPU bytes of the model rendered at LoD `lod`: the cut's interior nodes instead of LoD 0's.
-uint64_t lod_gpu_bytes(const NeuralModel& m, uint32_t lod) {
-    const uint64_t all = model_gpu_bytes(m);
-    if (lod >= m.lod_node_counts.size()) return all;
-    const uint64_t in0 = m.lod_node_counts[0] / 2 + 1, in_l = m.lod_node_counts[lod] / 2 + 1;
-    return all - in0 * sizeof(GpuBvhNode) + in_l * sizeof(GpuBvhNode);
 }
 
 void run_bench(const BenchArgs& a) {
@@ -106,11 +84,23 @@ void run_bench(const BenchArgs& a) {
     const Timed ref = time_renders(ctx, scene, accel, env, camera, ref_opt, a.repeat);
     const Image ref_px = as_png_pixels(ref.image);
     const double ref_ms = ref.stats.gpu_ms;
+    // The noise floor: the same classical render with other random numbers.
+    render::RenderOptions floor_opt = ref_opt;
+    floor_opt.seed = ref_opt.seed + 1;
+    const double floor = [&] {
+        render::WavefrontRenderer r(ctx, scene, accel, env, camera, floor_opt);
+        return double(flip_ldr(ref_px, as_png_pixels(r.render().image)).mean);
+    }();
+    const render::NeuralGpuBytes mem = render::neural_gpu_bytes(model);
 
     std::printf("device      %s (driver %s)\n", ref.stats.device.c_str(), ref.stats.driver.c_str());
     std::printf("scene       %s, %ux%u, %u spp, max depth %u; median of %u after 1 warm-up\n", a.scene.c_str(),
                 options.width, options.height, options.spp, options.max_depth, a.repeat);
-    std::printf("FLIP        LDR-FLIP vs the classical reference, both ACES tone-mapped to 8-bit sRGB (as PNGs)\n");
+    std::printf("FLIP        LDR-FLIP vs the classical reference (same seed and spp: shared random numbers), both "
+                "ACES tone-mapped to 8-bit sRGB (as PNGs)\n");
+    std::printf("noise floor %.4f (the classical render with another seed vs the reference; rows marked * are within "
+                "2x of it: not distinguishable from noise at %u spp; converged figures: nbvh study)\n",
+                floor, options.spp);
     std::printf("classical   %.3f ms/frame GPU\n\n", ref_ms);
     std::printf("%4s %8s %10s %12s %9s %12s %12s %8s\n", "LoD", "nodes", "memory MB", "GPU ms/frame",
                 "x classic", "queries/ray", "queries/s", "FLIP");
@@ -129,38 +119,41 @@ void run_bench(const BenchArgs& a) {
         const render::RenderStats& s = t.stats;
         path_name = s.neural_path;
         const uint32_t nodes = lod < model.lod_node_counts.size() ? model.lod_node_counts[lod] : 0;
-        const uint64_t bytes = lod_gpu_bytes(model, lod);
+        const uint64_t bytes = mem.total_for_lod(lod);
         const double ratio = ref_ms > 0.0 ? s.gpu_ms / ref_ms : 0.0;
-        std::printf("%4u %8u %10.3f %12.3f %9.2f %12.2f %12.3g %8.4f\n", lod, nodes, double(bytes) / 1.0e6, s.gpu_ms,
-                    ratio, s.neural_queries_per_ray(), s.neural_queries_per_second(), flip);
-        nlohmann::json passes = nlohmann::json::object();
-        for (const auto& [name, ms] : s.pass_ms) passes[name] = ms;
-        rows.push_back({{"lod", lod}, {"nodes", nodes}, {"neural_bytes", bytes}, {"gpu_ms", s.gpu_ms},
+        const bool noise = flip <= 2.0 * floor;
+        std::printf("%4u %8u %10.3f %12.3f %9.2f %12.2f %12.3g %8.4f%s\n", lod, nodes, double(bytes) / 1.0e6, s.gpu_ms,
+                    ratio, s.neural_queries_per_ray(), s.neural_queries_per_second(), flip, noise ? " *" : "");
+        rows.push_back({{"lod", lod}, {"nodes", nodes}, {"neural_bytes", bytes}, {"resident_bytes", mem.total()},
+                        {"within_2x_floor", noise}, {"gpu_ms", s.gpu_ms},
                         {"wall_ms", s.wall_ms}, {"ratio_to_classical", ratio}, {"neural_queries", s.neural_queries},
                         {"queries_per_ray", s.neural_queries_per_ray()},
                         {"queries_per_second", s.neural_queries_per_second()}, {"query_gpu_ms", s.neural_query_ms},
-                        {"pass_gpu_ms", passes}, {"flip", flip}});
+                        {"pass_gpu_ms", pass_ms_json(s)}, {"flip", flip}});
     }
     std::printf("\nneural path %s\n", path_name.c_str());
     if (ctx.validation_enabled() && ctx.validation_message_count() > 0)
         log_warn("bench: %d Vulkan validation messages", ctx.validation_message_count());
     if (a.json.empty()) return;
-    nlohmann::json ref_passes = nlohmann::json::object();
-    for (const auto& [name, ms] : ref.stats.pass_ms) ref_passes[name] = ms;
     nlohmann::json j = {{"scene", a.scene}, {"model", a.model}, {"assets", model.assets.size()},
+                        {"commit", build_commit()}, {"command_line", a.command_line},
+                        {"vulkan_validation", ctx.validation_enabled()}, {"noise_floor", floor},
                         {"device", ref.stats.device}, {"driver", ref.stats.driver}, {"width", options.width},
                         {"height", options.height}, {"spp", options.spp}, {"max_depth", options.max_depth},
                         {"repeat", a.repeat}, {"neural_path", path_name},
-                        {"flip_metric", "ldr: ACES tone map + 8-bit sRGB (as nbvh render PNGs), ppd 67.02"},
-                        {"classical", {{"gpu_ms", ref_ms}, {"wall_ms", ref.stats.wall_ms}, {"pass_gpu_ms", ref_passes}}},
+                        {"flip_metric", "ldr: ACES tone map + 8-bit sRGB (as nbvh render PNGs), ppd 67.02; hybrid and "
+                                        "reference share the seed"},
+                        {"classical",
+                         {{"gpu_ms", ref_ms}, {"wall_ms", ref.stats.wall_ms}, {"pass_gpu_ms", pass_ms_json(ref.stats)}}},
                         {"lods", rows}};
     write_text_atomically(a.json, j.dump(2) + "\n");
 }
 
 } // namespace
 
-void add_bench_command(CLI::App& app) {
+void add_bench_command(CLI::App& app, const std::string& command_line) {
     auto args = std::make_shared<BenchArgs>();
+    args->command_line = command_line;
     auto* cmd = app.add_subcommand("bench", "time the classical reference and every N-BVH level of detail; FLIP of each");
     cmd->add_option("scene", args->scene, "glTF/GLB file, or 'default' for the built-in scene")->required();
     cmd->add_option("--model", args->model, "N-BVH model (.nbvh) of the scene's neural asset")->required();

@@ -14,13 +14,10 @@
 
 #include "app/commands.h"
 #include "app/output_path.h"
-#include "assets/default_scene.h"
+#include "app/training_scene.h"
 #include "engine/core/error.h"
 #include "engine/core/log.h"
-#include "engine/neural/asset_table.h"
 #include "engine/neural/model_file.h"
-#include "engine/scene/gltf_loader.h"
-#include "engine/scene/scene_stats.h"
 #include "trainer/compact_hash.h"
 #include "trainer/evaluation.h"
 #include "trainer/model_export.h"
@@ -72,39 +69,8 @@ void run_train(const TrainArgs& a) {
     check_output_path(out, "--out", {a.scene});
     check_output_path(a.log_csv, "--log", {a.scene, out});
 
-    Scene scene;
-    uint64_t source_hash = 0;
-    if (a.scene == "default") {
-        scene = assets::make_default_scene();
-        if (!a.neural_glob.empty()) mark_neural_by_glob(scene, a.neural_glob);
-        // The built-in scene has no file to hash: hash its geometry, so the model still names its source.
-        source_hash = FNV1A64_OFFSET;
-        for (const Mesh& m : scene.meshes) {
-            source_hash = fnv1a64(m.positions.data(), m.positions.size() * sizeof(m.positions[0]), source_hash);
-            source_hash = fnv1a64(m.indices.data(), m.indices.size() * sizeof(m.indices[0]), source_hash);
-        }
-    } else {
-        SceneLoadOptions lo;
-        lo.neural_glob = a.neural_glob;
-        lo.require_geometry = true;
-        scene = load_gltf(a.scene, lo);
-        source_hash = fnv1a64_file(a.scene);
-    }
-    if (!a.neural_glob.empty()) {
-        bool matched = false;
-        for (const Instance& inst : scene.instances) matched = matched || inst.neural;
-        if (!matched)
-            throw Error(strfmt("--neural '%s' matches no node of '%s'", a.neural_glob.c_str(), a.scene.c_str()));
-    }
-    split_neural_meshes(scene);
-    std::vector<uint32_t> meshes;
-    for (uint32_t m : neural_meshes(scene))
-        if (a.asset_glob.empty() || glob_match(a.asset_glob, scene.meshes[m].name)) meshes.push_back(m);
-    if (meshes.empty()) {
-        if (!a.asset_glob.empty()) throw Error(strfmt("--asset '%s' matches no neural asset", a.asset_glob.c_str()));
-        pick_neural_mesh(scene); // throws the "no neural asset" message
-    }
-    const TrainingAsset asset = make_training_asset(scene, meshes);
+    const TrainingScene ts = load_training_scene(a.scene, a.neural_glob, a.asset_glob);
+    const TrainingAsset asset = make_training_asset(ts.scene, ts.meshes);
     if (!a.hash_log2) { // compact default (trainer/compact_hash.h): the grid <= 1/5 of the geometry
         const uint32_t max_log2 = opt.network.log2_hash_size;
         opt.network.log2_hash_size = compact_hash_log2(asset, opt.network, max_log2);
@@ -135,7 +101,7 @@ void run_train(const TrainArgs& a) {
                      100.0 * e.visibility_agreement, e.depth_mae, e.normal_mean_deg);
         }
     }
-    const NeuralModel model = make_neural_model(asset, result, opt, a.scene, source_hash);
+    const NeuralModel model = make_neural_model(asset, result, opt, a.scene, ts.source_hash);
     save_model(out, model);
     const LossTerms& l = result.log.back().loss;
     log_info("wrote %s: %u nodes, %u leaves, final loss %.4f (vis %.4f, depth %.4f, normal %.4f, albedo %.4f), "

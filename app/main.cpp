@@ -1,4 +1,4 @@
-// nbvh: neural BVH renderer. Subcommands: render, train, flip, info, bench, view.
+// nbvh: neural BVH renderer. Subcommands: render, train, flip, info, bench, study, view.
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/commands.h"
+#include "app/render_measure.h"
 #include "engine/core/error.h"
 
 int main(int argc, char** argv) {
@@ -15,7 +16,9 @@ int main(int argc, char** argv) {
     nbvh::app::add_train_command(app);
     nbvh::app::add_flip_command(app);
     nbvh::app::add_info_command(app);
-    nbvh::app::add_bench_command(app);
+    const std::string command = nbvh::app::command_line(argc, argv);
+    nbvh::app::add_bench_command(app, command);
+    nbvh::app::add_study_command(app, command);
     nbvh::app::add_view_command(app);
     try {
         app.parse(argc, argv);

@@ -1,5 +1,7 @@
 // nbvh bench on lavapipe: one row per level of detail with positive GPU times and a finite FLIP in
-// [0,1] against the classical reference; user errors (missing model, wrong asset) are one clean line.
+// [0,1] against the classical reference, the noise floor beside it, commit and command line in the JSON;
+// any scene (a glTF file without "*_neural" nodes, its model trained with --neural); user errors
+// (missing model, wrong asset) are one clean line.
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -48,6 +50,11 @@ TEST(Bench, TinyModelOnLavapipe) {
     ASSERT_TRUE(f.good());
     const nlohmann::json j = nlohmann::json::parse(f);
     EXPECT_FALSE(j["device"].get<std::string>().empty());
+    EXPECT_FALSE(j["commit"].get<std::string>().empty());
+    EXPECT_NE(j["command_line"].get<std::string>().find("bench default"), std::string::npos);
+    const double floor = j["noise_floor"].get<double>();
+    EXPECT_TRUE(std::isfinite(floor) && floor > 0.0 && floor <= 1.0) << floor;
+    EXPECT_NE(r.out.find("noise floor"), std::string::npos) << r.out;
     EXPECT_GT(j["classical"]["gpu_ms"].get<double>(), 0.0);
     const auto& rows = j["lods"];
     ASSERT_EQ(rows.size(), 2u) << j.dump(2); // --lods 2
@@ -56,6 +63,8 @@ TEST(Bench, TinyModelOnLavapipe) {
         EXPECT_EQ(row["lod"].get<uint32_t>(), i);
         EXPECT_GT(row["nodes"].get<uint32_t>(), 0u);
         EXPECT_GT(row["neural_bytes"].get<uint64_t>(), 0u);
+        EXPECT_GE(row["resident_bytes"].get<uint64_t>(), row["neural_bytes"].get<uint64_t>());
+        EXPECT_EQ(row["within_2x_floor"].get<bool>(), row["flip"].get<double>() <= 2.0 * floor);
         EXPECT_GT(row["gpu_ms"].get<double>(), 0.0);
         EXPECT_GT(row["ratio_to_classical"].get<double>(), 0.0);
         EXPECT_GT(row["neural_queries"].get<uint64_t>(), 0u); // the camera sees the neural asset
@@ -64,6 +73,26 @@ TEST(Bench, TinyModelOnLavapipe) {
     }
     // Coarser cuts have fewer nodes.
     EXPECT_LT(rows[1]["nodes"].get<uint32_t>(), rows[0]["nodes"].get<uint32_t>());
+}
+
+// A glTF scene with no "*_neural" node: the model (trained with --neural) decides which instances are neural.
+TEST(Bench, AnySceneWithItsModel) {
+    NBVH_REQUIRE_SHARED();
+    const fs::path scene = nbvh::test::scenes_dir() / "stanford_bunny" / "stanford_bunny.glb";
+    const fs::path dir = nbvh::test::temp_dir("bench_bunny");
+    const fs::path model = dir / "bunny.nbvh", json = dir / "out.json";
+    auto r = run_nbvh({"train", scene.string(), "--neural", "*", "--backend", "cpu", "--steps", "10", "--batch", "256",
+                       "--nodes", "15", "--hash-log2", "10", "--threads", "2", "--out", model.string()},
+                      120.0);
+    ASSERT_EQ(r.exit_code, 0) << r.describe();
+    r = run_nbvh({"bench", scene.string(), "--model", model.string(), "--device", "cpu", "--width", "32", "--height",
+                  "32", "--spp", "1", "--repeat", "1", "--json", json.string()},
+                 120.0);
+    ASSERT_EQ(r.exit_code, 0) << r.describe();
+    std::ifstream f(json);
+    const nlohmann::json j = nlohmann::json::parse(f);
+    ASSERT_EQ(j["lods"].size(), 1u);
+    EXPECT_GT(j["lods"][0]["neural_queries"].get<uint64_t>(), 0u) << "the bunny is neural";
 }
 
 TEST(Bench, MissingModelIsOneLine) {

@@ -1,0 +1,182 @@
+// `nbvh study` end to end on lavapipe (issue 11): a tiny sweep (default scene, 2 node budgets, 2 LoDs,
+// 2 cameras, 64x64, CPU-trained tiny models) writes study.csv and study.json with the promised columns,
+// finite figures, positive memory and times, the noise floor beside every FLIP, decimated rows at the
+// model's bytes; scripts/bench/plot_study.py turns the JSON into valid PNG plots and a table.
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/cli/run_nbvh.h"
+#include "tests/support/test_support.h"
+
+namespace {
+namespace fs = std::filesystem;
+using nbvh::test::check_clean_error;
+using nbvh::test::run_nbvh;
+
+std::vector<std::string> split(const std::string& line, char sep = ',') {
+    std::vector<std::string> out;
+    std::stringstream ss(line);
+    for (std::string f; std::getline(ss, f, sep);) out.push_back(f);
+    if (!line.empty() && line.back() == sep) out.push_back("");
+    return out;
+}
+
+double num(const std::string& s) { return s.empty() ? NAN : std::stod(s); }
+
+struct Study {
+    fs::path dir;
+    nbvh::test::RunResult run;
+};
+
+bool is_png(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    char sig[8] = {};
+    f.read(sig, 8);
+    return f.gcount() == 8 && std::string(sig, 8) == std::string("\x89PNG\r\n\x1a\n", 8) && fs::file_size(p) > 1000;
+}
+
+// The sweep (about a minute on lavapipe).
+const Study& tiny_study() {
+    static const Study s = [] {
+        Study st;
+        st.dir = nbvh::test::temp_dir("study_tiny") / "out";
+        st.run = run_nbvh({"study", "default", "--out", st.dir.string(), "--device", "cpu", "--backend", "cpu",
+                           "--steps", "20", "--batch", "256", "--nodes", "31,63", "--hash-log2", "12", "--lods", "2",
+                           "--threads", "2", "--cameras", "2", "--width", "64", "--height", "64", "--spp", "2",
+                           "--ref-spp", "8", "--repeat", "1", "--save-images"},
+                          500.0);
+        return st;
+    }();
+    return s;
+}
+
+TEST(Study, TinySweepWritesCsvJsonAndPlots) {
+    const Study& s = tiny_study();
+    ASSERT_EQ(s.run.exit_code, 0) << s.run.describe();
+    std::ifstream csv(s.dir / "study.csv");
+    ASSERT_TRUE(csv.good());
+    std::string header;
+    std::getline(csv, header);
+    const std::vector<std::string> cols = split(header);
+    for (const char* c : {"config", "variant", "camera", "nodes", "hash_log2", "lod", "memory_bytes", "frame_ms",
+                          "classical_frame_ms", "flip", "noise_floor", "within_2x_floor", "converged", "train_seconds",
+                          "equal_time_spp", "equal_time_flip", "compression", "triangles"})
+        EXPECT_NE(std::find(cols.begin(), cols.end(), c), cols.end()) << c << " missing in " << header;
+    std::map<std::string, size_t> at;
+    for (size_t i = 0; i < cols.size(); ++i) at[cols[i]] = i;
+    std::map<std::string, int> per_variant;
+    for (std::string line; std::getline(csv, line);) {
+        const std::vector<std::string> f = split(line);
+        ASSERT_EQ(f.size(), cols.size()) << line;
+        const std::string variant = f[at["variant"]];
+        if (f[at["camera"]] != "mean") per_variant[variant]++;
+        // Every row: positive memory and frame time, a finite FLIP in [0,1] and its noise floor beside it.
+        EXPECT_GT(num(f[at["memory_bytes"]]), 0.0) << line;
+        EXPECT_GT(num(f[at["frame_ms"]]), 0.0) << line;
+        EXPECT_GT(num(f[at["classical_frame_ms"]]), 0.0) << line;
+        const double flip = num(f[at["flip"]]), floor = num(f[at["noise_floor"]]);
+        EXPECT_TRUE(std::isfinite(flip) && flip >= 0.0 && flip <= 1.0) << line;
+        EXPECT_TRUE(std::isfinite(floor) && floor > 0.0 && floor <= 1.0) << line;
+        EXPECT_EQ(f[at["within_2x_floor"]] == "1", flip <= 2.0 * floor) << line;
+        if (variant == "lod" || variant == "switch" || variant == "cap") {
+            EXPECT_GT(num(f[at["nodes"]]), 0.0) << line;
+            EXPECT_GT(num(f[at["train_seconds"]]), 0.0) << line;
+            EXPECT_GT(num(f[at["compression"]]), 1.0) << line; // 384k triangles vs a 2^12 grid
+            if ((variant == "lod" && f[at["lod"]] == "0") || variant == "switch") {
+                EXPECT_GE(num(f[at["equal_time_spp"]]), 1.0) << line;
+                EXPECT_TRUE(std::isfinite(num(f[at["equal_time_flip"]]))) << line;
+            }
+        }
+        if (variant == "decimated") {
+            EXPECT_GT(num(f[at["triangles"]]), 0.0) << line;
+        }
+    }
+    // 2 configs x 2 cameras: 2 LoDs + LoD switch each, a decimated row each, the raised leaf budget for the
+    // middle configuration; 2 classical.
+    EXPECT_EQ(per_variant["lod"], 8);
+    EXPECT_EQ(per_variant["switch"], 4);
+    EXPECT_EQ(per_variant["cap"], 2);
+    EXPECT_EQ(per_variant["decimated"], 4);
+    EXPECT_EQ(per_variant["classical"], 2);
+
+    std::ifstream jf(s.dir / "study.json");
+    const nlohmann::json j = nlohmann::json::parse(jf);
+    for (const char* k : {"device", "driver", "commit", "command_line", "started_utc"})
+        EXPECT_FALSE(j[k].get<std::string>().empty()) << k;
+    EXPECT_TRUE(j["complete"].get<bool>());
+    EXPECT_NE(j["command_line"].get<std::string>().find("study default"), std::string::npos);
+    ASSERT_EQ(j["cameras"].size(), 2u);
+    for (const auto& c : j["cameras"]) EXPECT_GT(c["noise_floor"].get<double>(), 0.0);
+    ASSERT_EQ(j["configs"].size(), 2u);
+    for (const auto& c : j["configs"]) {
+        EXPECT_GT(c["neural_bytes"]["total"].get<uint64_t>(), c["neural_bytes"]["grid"].get<uint64_t>());
+        EXPECT_EQ(c["lod_node_counts"].size(), 2u);
+    }
+    // Decimated rows: the meshes at the bytes of the LoD-0 model, within 5 %.
+    std::map<int, uint64_t> lod0_bytes;
+    for (const auto& r : j["rows"])
+        if (r["variant"] == "lod" && r["lod"] == 0) lod0_bytes[r["config"].get<int>()] = r["memory_bytes"];
+    for (const auto& r : j["rows"])
+        if (r["variant"] == "decimated") {
+            const double target = double(lod0_bytes.at(r["config"].get<int>()));
+            EXPECT_NEAR(r["memory_bytes"].get<double>() / target, 1.0, 0.05) << r.dump();
+        }
+    for (const char* img : {"reference_cam0.png", "hybrid_cam0.png", "decimated_cam0.png"})
+        EXPECT_TRUE(fs::exists(s.dir / img)) << img;
+
+    // The plots and the table of scripts/bench/plot_study.py.
+    const fs::path python = "/usr/bin/python3"; // Debian's, with python3-matplotlib (scripts/setup.sh)
+    const auto probe = nbvh::test::run_command(python, {"-c", "import matplotlib"}, 60.0);
+    if (probe.exit_code != 0) GTEST_SKIP() << "python3-matplotlib is not installed (scripts/setup.sh installs it): plots not checked";
+    const fs::path out = nbvh::test::temp_dir("study_plots");
+    const auto r = nbvh::test::run_command(
+        python, {(nbvh::test::source_dir() / "scripts/bench/plot_study.py").string(), (s.dir / "study.json").string(),
+                 out.string()},
+        120.0);
+    ASSERT_EQ(r.exit_code, 0) << r.describe();
+    for (const char* png : {"error_vs_time.png", "error_vs_memory.png", "training_vs_error.png"})
+        EXPECT_TRUE(is_png(out / png)) << png;
+    std::ifstream t(out / "table.md");
+    std::stringstream text;
+    text << t.rdbuf();
+    EXPECT_NE(text.str().find("noise floor"), std::string::npos);
+    EXPECT_NE(text.str().find("llvmpipe"), std::string::npos) << "the device is named";
+}
+
+// A time budget stops before a configuration that would end past it; what ran is written, marked incomplete.
+TEST(Study, BudgetStopsBetweenConfigurations) {
+    const fs::path dir = nbvh::test::temp_dir("study_budget") / "out";
+    const auto r = run_nbvh({"study", "default", "--out", dir.string(), "--device", "cpu", "--backend", "cpu",
+                             "--steps", "5", "--batch", "128", "--nodes", "15,31", "--hash-log2", "10", "--lods", "1",
+                             "--threads", "2", "--cameras", "1", "--width", "16", "--height", "16", "--spp", "1",
+                             "--ref-spp", "2", "--repeat", "1", "--no-decimation", "--no-equal-time",
+                             "--budget-minutes", "0.0001"},
+                            300.0);
+    ASSERT_EQ(r.exit_code, 0) << r.describe();
+    std::ifstream jf(dir / "study.json");
+    const nlohmann::json j = nlohmann::json::parse(jf);
+    EXPECT_FALSE(j["complete"].get<bool>());
+    EXPECT_EQ(j["configs_done"].get<int>(), 1);
+    EXPECT_EQ(j["configs_planned"].get<int>(), 2);
+    EXPECT_NE(j["stop_reason"].get<std::string>().find("budget"), std::string::npos);
+    EXPECT_EQ(j["configs"].size(), 1u);
+}
+
+TEST(Study, BadOptionsFailBeforeAnyWork) {
+    const fs::path dir = nbvh::test::temp_dir("study_bad");
+    auto r = run_nbvh({"study", "default", "--out", (dir / "o").string(), "--device", "cpu", "--spp", "64",
+                       "--ref-spp", "16"});
+    EXPECT_EQ(check_clean_error(r, {"--ref-spp"}), "") << r.describe();
+    r = run_nbvh({"study", "default", "--out", (dir / "no" / "such" / "o").string(), "--device", "cpu"});
+    EXPECT_EQ(check_clean_error(r, {"--out"}), "") << r.describe();
+    r = run_nbvh({"study", "default", "--out", (dir / "o").string(), "--hash-log2", "2"});
+    EXPECT_EQ(check_clean_error(r, {"--hash-log2"}), "") << r.describe();
+    EXPECT_FALSE(fs::exists(dir / "o" / "study.json"));
+}
+
+} // namespace
