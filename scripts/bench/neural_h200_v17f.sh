@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# As run for results/neural/ (moved from results/neural/gpu_run_*.sh; .devbin/ and build-qps-dev/ were that
+# session's ignored folders of binaries: nbvh, nbvh_cuda (CUDA build), bench_final = nbvh_bench_neural).
 # GPU session v17, final run (committed figures): the final kernel (weight tiles, paired gather of 4
 # levels at once) in nbvh_bench_neural (random and coherent queries; the fp16-accumulator kernel is
 # checked too), the 1080p frame (classical, hybrid coopmat, hybrid scalar) and `nbvh bench` with the

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# As run for results/neural/ (moved from results/neural/gpu_run_*.sh; .devbin/ and build-qps-dev/ were that
+# session's ignored folders of binaries: nbvh, nbvh_cuda (CUDA build), bench_final = nbvh_bench_neural).
 # GPU session v18, run 2 (committed figures of the v18 code): `nbvh bench` per LoD with the v14 CPU
 # model, then a paper-size model of the default scene trained on this GPU (CUDA backend, defaults,
 # --lods 5) and rendered at 1080p 4 spp: <= 4 leaves/ray with secondary LoD 4, and <= 8 leaves/ray on

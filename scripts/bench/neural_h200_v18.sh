@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# As run for results/neural/ (moved from results/neural/gpu_run_*.sh; .devbin/ and build-qps-dev/ were that
+# session's ignored folders of binaries: nbvh, nbvh_cuda (CUDA build), bench_final = nbvh_bench_neural).
 # GPU session v18 (same day as v17): a ray whose queued group is its last (fewer leaves found than
 # looked for, or leaf budget spent: NB_NRAY_PENDING_LAST) is finished by the resumed round without
 # re-traversing. The v17 build (.devbin/nbvh_v17) and this build (.devbin/nbvh) in one run, default
