@@ -280,10 +280,12 @@ void StudyRun::run_config(size_t index, const Config& c) {
     const std::string label = strfmt("config %zu/%zu (nodes %u, hash 2^%u)", index + 1, configs_.size(), c.nodes,
                                      c.hash_log2);
     progress_.begin(StudyTask::train, double(opt.steps) * opt.batch_size, label + ": training");
-    std::unique_ptr<TrainerBackend> be = make_backend(backend_, *asset_, opt);
-    const TrainResult tr = train_asset(*asset_, opt, *be, [&](const TrainProgress& p) {
-        progress_.partial(double(p.step) / double(std::max(1u, p.steps)));
-    });
+    const TrainResult tr = [&] { // the backend (its GPU memory) is gone before the renders
+        std::unique_ptr<TrainerBackend> be = make_backend(backend_, *asset_, opt);
+        return train_asset(*asset_, opt, *be, [&](const TrainProgress& p) {
+            progress_.partial(double(p.step) / double(std::max(1u, p.steps)));
+        });
+    }();
     const NeuralModel model = make_neural_model(*asset_, tr, opt, o_.scene, ts_.source_hash);
     const render::NeuralGpuBytes bytes = render::neural_gpu_bytes(model);
     progress_.end(strfmt("%u nodes, %s, final loss %.4f, %.1f s", tr.tree.node_count(),

@@ -3,6 +3,7 @@
 // finite figures, positive memory and times, the noise floor beside every FLIP, decimated rows at the
 // model's bytes; scripts/bench/plot_study.py turns the JSON into valid PNG plots and a table.
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -45,11 +46,15 @@ const Study& tiny_study() {
     static const Study s = [] {
         Study st;
         st.dir = nbvh::test::temp_dir("study_tiny") / "out";
+        setenv("NBVH_VALIDATION", "1", 1); // the child runs with the validation layer; any message fails
+        // Frames timed at another size than the images: their own renderers.
         st.run = run_nbvh({"study", "default", "--out", st.dir.string(), "--device", "cpu", "--backend", "cpu",
                            "--steps", "20", "--batch", "256", "--nodes", "31,63", "--hash-log2", "12", "--lods", "2",
                            "--threads", "2", "--cameras", "2", "--width", "64", "--height", "64", "--spp", "2",
-                           "--ref-spp", "8", "--repeat", "1", "--save-images"},
+                           "--ref-spp", "8", "--repeat", "1", "--time-width", "32", "--time-height", "32",
+                           "--save-images"},
                           500.0);
+        unsetenv("NBVH_VALIDATION");
         return st;
     }();
     return s;
@@ -58,6 +63,8 @@ const Study& tiny_study() {
 TEST(Study, TinySweepWritesCsvJsonAndPlots) {
     const Study& s = tiny_study();
     ASSERT_EQ(s.run.exit_code, 0) << s.run.describe();
+    EXPECT_EQ(s.run.err.find("vulkan validation"), std::string::npos) << s.run.err;
+    EXPECT_NE(s.run.err.find("wrote"), std::string::npos) << s.run.err;
     std::ifstream csv(s.dir / "study.csv");
     ASSERT_TRUE(csv.good());
     std::string header;
@@ -109,6 +116,8 @@ TEST(Study, TinySweepWritesCsvJsonAndPlots) {
     for (const char* k : {"device", "driver", "commit", "command_line", "started_utc"})
         EXPECT_FALSE(j[k].get<std::string>().empty()) << k;
     EXPECT_TRUE(j["complete"].get<bool>());
+    EXPECT_TRUE(j["vulkan_validation"].get<bool>());
+    EXPECT_EQ(j["settings"]["time_width"].get<int>(), 32);
     EXPECT_NE(j["command_line"].get<std::string>().find("study default"), std::string::npos);
     ASSERT_EQ(j["cameras"].size(), 2u);
     for (const auto& c : j["cameras"]) EXPECT_GT(c["noise_floor"].get<double>(), 0.0);
