@@ -1,5 +1,6 @@
 // nbvh info MODEL: what a .nbvh model holds — hyperparameters, the N-BVH per level of detail, memory of
-// the neural part against the triangles it replaces, and how it was trained.
+// the neural part (every GPU buffer a hybrid render holds) against the triangles it replaces, and how it
+// was trained.
 #include <cstdio>
 #include <ctime>
 #include <string>
@@ -8,6 +9,7 @@
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/neural/model_file.h"
+#include "engine/render/gpu_memory.h"
 
 namespace nbvh::app {
 
@@ -60,12 +62,15 @@ void print_model(const std::string& path) {
         std::printf("  LoD %u      %8u nodes  %8u leaves%s\n", l, n, (n + 1) / 2,
                     l == 0 ? "  (finest)" : (l + 1 == m.lod_count ? "  (coarsest)" : ""));
     }
-    const uint64_t nodes_b = uint64_t(m.lod_node_counts[0] / 2 + 1) * sizeof(GpuBvhNode);
-    const uint64_t mlp_b = m.mlp.size() * 2, grid_b = m.grid.size() * 2;
-    const uint64_t neural = model_gpu_bytes(m);
-    std::printf("memory       %s neural (grid %s, mlp %s, nodes %s)\n", human_bytes(double(neural)).c_str(),
-                human_bytes(double(grid_b)).c_str(), human_bytes(double(mlp_b)).c_str(),
-                human_bytes(double(nodes_b)).c_str());
+    // Every GPU buffer a hybrid render holds for the model (engine/render/gpu_memory.h).
+    const render::NeuralGpuBytes b = render::neural_gpu_bytes(m);
+    const uint64_t neural = b.total();
+    std::printf("memory       %s on the GPU (grid %s, mlp %s + its transposed copy, nodes of %zu LoD(s) %s + bounds "
+                "%s, level table %s, asset table %s); with LoD 0 alone %s\n",
+                human_bytes(double(neural)).c_str(), human_bytes(double(b.grid)).c_str(),
+                human_bytes(double(b.mlp)).c_str(), b.lod_nodes.size(), human_bytes(double(b.nodes)).c_str(),
+                human_bytes(double(b.node_bounds)).c_str(), human_bytes(double(b.levels)).c_str(),
+                human_bytes(double(b.assets)).c_str(), human_bytes(double(b.total_for_lod(0))).c_str());
     if (m.meta.source_triangles > 0) {
         const uint64_t classic = classical_bytes(m.meta);
         std::printf("replaces     %llu triangles, %llu vertices: ~%s as mesh + BLAS -> compression %.1fx\n",
