@@ -17,14 +17,18 @@ NBVH=${NBVH:-.device/study/bin/nbvh}
 mkdir -p "$OUT"
 TMP=${TMPDIR:-/tmp}/nbvh_study
 mkdir -p "$TMP"
+unpack() { # SRC.xz DST: xz, else Python's lzma (both are on the GPU machine's Ubuntu; one is enough)
+  if command -v xz >/dev/null; then xz -dc "$1" > "$2"
+  else python3 -c 'import lzma, shutil, sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2], "wb"))' "$1" "$2"; fi
+}
 case "$WHICH" in
   default) SCENE=(default) ;;
   dragon)
-    xz -dc .device/study/dragon/dragon_vrip.glb.xz > "$TMP/dragon_vrip.glb"
+    unpack .device/study/dragon/dragon_vrip.glb.xz "$TMP/dragon_vrip.glb"
     SCENE=("$TMP/dragon_vrip.glb" --neural '*') ;;
   chess)
     # The paper's camera and environment (scripts/bench/chess.sh): 48 neural pieces, 14 assets, one model.
-    xz -dc .device/study/chess/abeautifulgame.glb.xz > "$TMP/abeautifulgame.glb"
+    unpack .device/study/chess/abeautifulgame.glb.xz "$TMP/abeautifulgame.glb"
     SCENE=("$TMP/abeautifulgame.glb" --camera 0.600,0.358,0.179,-0.197,-0.197,-0.057,45
            --env .device/study/chess/photo_studio_loft_hall_512x256.hdr --env-rotation 285 --exposure 0) ;;
   *) echo "study.sh: scene must be default, dragon or chess" >&2; exit 2 ;;
