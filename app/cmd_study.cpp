@@ -17,18 +17,23 @@ namespace nbvh::app {
 void add_study_command(CLI::App& app, const std::string& command_line) {
     auto o = std::make_shared<StudyOptions>();
     o->command_line = command_line;
-    auto* cmd = app.add_subcommand("study", "sweep node budgets x hash sizes x LoDs over several cameras: frame time, "
-                                            "memory, training time and converged FLIP vs baselines (CSV + JSON)");
-    cmd->option_defaults()->always_capture_default(); // --help shows the study's defaults (960x540, 256 spp ...)
+    auto* cmd = app.add_subcommand("study",
+                                   "sweep node budgets x hash sizes x LoDs over several cameras: frame time, "
+                                   "memory, training time and converged FLIP vs baselines (CSV + JSON)");
+    cmd->option_defaults()
+        ->always_capture_default(); // --help shows the study's defaults (960x540, 256 spp ...)
     cmd->add_option("scene", o->scene, "glTF/GLB file, or 'default' for the built-in scene")->required();
     cmd->add_option("--out", o->out_dir, "output folder (study.json, study.csv; created)")->required();
-    cmd->add_option("--neural", o->neural_glob, "glob of node names to make neural (overrides '*_neural' scenes)");
+    cmd->add_option("--neural", o->neural_glob,
+                    "glob of node names to make neural (overrides '*_neural' scenes)");
     cmd->add_option("--asset", o->asset_glob, "learn only the neural assets whose name matches this glob");
-    cmd->add_option("--nodes", o->nodes, "N-BVH node budgets to train, comma-separated (default: the backend's)")
+    cmd->add_option("--nodes", o->nodes,
+                    "N-BVH node budgets to train, comma-separated (default: the backend's)")
         ->delimiter(',')
         ->check(CLI::Range(1u, 1u << 26));
-    cmd->add_option("--hash-log2", o->hash_log2, "hash-table sizes (log2) to train, comma-separated (default: "
-                                                  "nbvh train's compact default)")
+    cmd->add_option("--hash-log2", o->hash_log2,
+                    "hash-table sizes (log2) to train, comma-separated (default: "
+                    "nbvh train's compact default)")
         ->delimiter(',')
         ->check(CLI::Range(4u, 24u));
     cmd->add_option("--lods", o->lods, "levels of detail per model (each one a row)");
@@ -40,12 +45,15 @@ void add_study_command(CLI::App& app, const std::string& command_line) {
     cmd->add_option("--camera", o->cameras, "a camera (ex,ey,ez,tx,ty,tz,fov_deg); repeat for several")
         ->take_all()
         ->allow_extra_args(false);
-    cmd->add_option("--cameras", o->camera_count, "cameras in all: the given or scene's one, then orbits around it")
+    cmd->add_option("--cameras", o->camera_count,
+                    "cameras in all: the given or scene's one, then orbits around it")
         ->check(CLI::Range(1u, 16u));
-    add_render_option_flags(cmd, o->render); // --width --height --spp (compared images) --max-depth --seed ...
+    add_render_option_flags(cmd,
+                            o->render); // --width --height --spp (compared images) --max-depth --seed ...
     cmd->add_option("--ref-spp", o->ref_spp, "samples per pixel of the classical reference (another seed)")
         ->check(CLI::Range(1u, 1u << 20));
-    cmd->add_option("--time-spp", o->time_spp, "samples per pixel of the timed frames")->check(CLI::Range(1u, 4096u));
+    cmd->add_option("--time-spp", o->time_spp, "samples per pixel of the timed frames")
+        ->check(CLI::Range(1u, 4096u));
     cmd->add_option("--repeat", o->repeat, "timed frames per row after a warm-up (the median is reported)")
         ->check(CLI::Range(1u, 1000u));
     cmd->add_option("--time-width", o->time_width, "width of the timed frames (default: --width)")
@@ -56,17 +64,20 @@ void add_study_command(CLI::App& app, const std::string& command_line) {
     cmd->add_option("--env", o->env, "environment map (.hdr or .exr), or 'none' (the scene's lights only)");
     cmd->add_option("--env-rotation", o->env_rotation, "rotate the environment about +y by this many degrees")
         ->check(CLI::Range(-3600.0f, 3600.0f));
-    cmd->add_option("--exposure", o->exposure, "PNG exposure of every compared image: 'auto' (the reference's, per "
-                                               "camera) or stops");
+    cmd->add_option("--exposure", o->exposure,
+                    "PNG exposure of every compared image: 'auto' (the reference's, per "
+                    "camera) or stops");
     cmd->add_option("--neural-path", o->neural_path, "MLP implementation: auto, scalar or coopmat");
     cmd->add_option("--cap-study", o->cap_study, "extra LoD-0 rows with this per-ray leaf budget (0: none)")
         ->check(CLI::Range(0u, 256u));
     cmd->add_flag("!--no-decimation", o->decimation, "skip the equal-memory decimation baseline");
     cmd->add_flag("!--no-equal-time", o->equal_time, "skip the equal-time classical baseline");
-    cmd->add_option("--budget-minutes", o->budget_minutes,
-                    "start no configuration that would end after this many minutes (the rest is reported as not run)")
+    cmd->add_option(
+           "--budget-minutes", o->budget_minutes,
+           "start no configuration that would end after this many minutes (the rest is reported as not run)")
         ->check(CLI::Range(0.0, 1.0e6));
-    cmd->add_flag("--save-images", o->save_images, "also write camera 0's reference, hybrid and decimated PNGs");
+    cmd->add_flag("--save-images", o->save_images,
+                  "also write camera 0's reference, hybrid and decimated PNGs");
     cmd->callback([o] {
         o->commit = build_commit();
         run_study(*o);

@@ -21,7 +21,8 @@ Image as_png_pixels(const Image& linear, float exposure_stops) {
     const std::vector<uint8_t> px = to_srgb8(linear, enc, &channels);
     Image out(linear.width, linear.height, 3);
     for (size_t i = 0; i < linear.pixel_count(); ++i)
-        for (int c = 0; c < 3; ++c) out.data[i * 3 + c] = srgb_to_linear(float(px[i * size_t(channels) + c]) / 255.0f);
+        for (int c = 0; c < 3; ++c)
+            out.data[i * 3 + c] = srgb_to_linear(float(px[i * size_t(channels) + c]) / 255.0f);
     return out;
 }
 

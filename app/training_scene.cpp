@@ -21,7 +21,8 @@ TrainingScene load_training_scene(const std::string& scene_arg, const std::strin
         // The built-in scene has no file to hash: hash its geometry, so the model still names its source.
         t.source_hash = FNV1A64_OFFSET;
         for (const Mesh& m : scene.meshes) {
-            t.source_hash = fnv1a64(m.positions.data(), m.positions.size() * sizeof(m.positions[0]), t.source_hash);
+            t.source_hash =
+                fnv1a64(m.positions.data(), m.positions.size() * sizeof(m.positions[0]), t.source_hash);
             t.source_hash = fnv1a64(m.indices.data(), m.indices.size() * sizeof(m.indices[0]), t.source_hash);
         }
     } else {
@@ -35,13 +36,15 @@ TrainingScene load_training_scene(const std::string& scene_arg, const std::strin
         bool matched = false;
         for (const Instance& inst : scene.instances) matched = matched || inst.neural;
         if (!matched)
-            throw Error(strfmt("--neural '%s' matches no node of '%s'", neural_glob.c_str(), scene_arg.c_str()));
+            throw Error(
+                strfmt("--neural '%s' matches no node of '%s'", neural_glob.c_str(), scene_arg.c_str()));
     }
     split_neural_meshes(scene);
     for (uint32_t m : neural_meshes(scene))
         if (asset_glob.empty() || glob_match(asset_glob, scene.meshes[m].name)) t.meshes.push_back(m);
     if (t.meshes.empty()) {
-        if (!asset_glob.empty()) throw Error(strfmt("--asset '%s' matches no neural asset", asset_glob.c_str()));
+        if (!asset_glob.empty())
+            throw Error(strfmt("--asset '%s' matches no neural asset", asset_glob.c_str()));
         pick_neural_mesh(scene); // throws the "no neural asset" message
     }
     return t;

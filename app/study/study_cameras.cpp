@@ -37,8 +37,8 @@ std::vector<Camera> study_cameras(const Scene& scene, const std::vector<std::str
 }
 
 std::string camera_string(const Camera& c) {
-    return strfmt("%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g", c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z,
-                  double(glm::degrees(c.yfov)));
+    return strfmt("%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g", c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y,
+                  c.target.z, double(glm::degrees(c.yfov)));
 }
 
 } // namespace nbvh::app

@@ -13,12 +13,12 @@ namespace nbvh::app {
 struct StudyOptions {
     std::string scene, neural_glob, asset_glob, out_dir;
     std::string env, device = "auto", backend = "auto", exposure = "auto";
-    std::optional<float> env_rotation;  // degrees
-    std::string command_line, commit;   // written into the results
+    std::optional<float> env_rotation; // degrees
+    std::string command_line, commit;  // written into the results
 
     // Sweep: every node budget x every hash size is trained once (empty: the backend's default, one value).
     std::vector<uint32_t> nodes, hash_log2;
-    uint32_t lods = 3;                  // levels of detail per model: each is a row
+    uint32_t lods = 3; // levels of detail per model: each is a row
     std::optional<uint32_t> steps, batch;
     uint32_t threads = 0;
     uint64_t train_seed = 1337;
@@ -34,11 +34,12 @@ struct StudyOptions {
     uint32_t ref_spp = 1024, time_spp = 4, repeat = 3;
     uint32_t time_width = 0, time_height = 0; // frame times at another size (0: the image size)
     std::string neural_path = "auto";
-    uint32_t cap_study = 64;            // extra LoD-0 rows with this per-ray leaf budget (0: none)
-    bool decimation = true;             // equal-memory meshoptimizer baseline rows
-    bool equal_time = true;             // classical at the spp that fits the hybrid's frame time
+    uint32_t cap_study = 64; // extra LoD-0 rows with this per-ray leaf budget (0: none)
+    bool decimation = true;  // equal-memory meshoptimizer baseline rows
+    bool equal_time = true;  // classical at the spp that fits the hybrid's frame time
     bool save_images = false;
-    double budget_minutes = 0.0;        // > 0: start no configuration that would end past this (wall time)           // reference / hybrid / decimated PNGs of camera 0 (first config)
+    double budget_minutes = 0.0; // > 0: start no configuration that would end past this (wall time) //
+                                 // reference / hybrid / decimated PNGs of camera 0 (first config)
 
     StudyOptions() {
         render.width = 960;

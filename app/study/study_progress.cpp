@@ -108,8 +108,8 @@ void StudyProgress::draw(bool force) {
     const int width = 24, filled = int(width * f);
     std::string bar(size_t(filled), '#');
     bar.append(size_t(width - filled), '.');
-    std::fprintf(out_, "\r[%s] %3.0f%%  %d/%d  %s  ETA %s\x1b[K", bar.c_str(), 100.0 * f, tasks_done_, tasks_planned_,
-                 label_.c_str(), format_duration(eta_seconds()).c_str());
+    std::fprintf(out_, "\r[%s] %3.0f%%  %d/%d  %s  ETA %s\x1b[K", bar.c_str(), 100.0 * f, tasks_done_,
+                 tasks_planned_, label_.c_str(), format_duration(eta_seconds()).c_str());
     open_line_ = true;
     std::fflush(out_);
 }

@@ -12,19 +12,19 @@ namespace nbvh::app {
 enum class StudyTask { train = 0, render = 1 };
 
 class StudyProgress {
-public:
+  public:
     explicit StudyProgress(FILE* out = stderr);
     ~StudyProgress();
 
-    void plan(StudyTask kind, double work);        // adds a task to the total
+    void plan(StudyTask kind, double work); // adds a task to the total
     void begin(StudyTask kind, double work, std::string label);
-    void partial(double fraction);                 // of the running task (training steps)
-    void end(const std::string& result = {});      // the running task is done; `result` is printed beside it
-    void note(const std::string& line);            // a line of its own (the bar is redrawn after it)
+    void partial(double fraction);            // of the running task (training steps)
+    void end(const std::string& result = {}); // the running task is done; `result` is printed beside it
+    void note(const std::string& line);       // a line of its own (the bar is redrawn after it)
     double eta_seconds() const;
     double elapsed_seconds() const;
 
-private:
+  private:
     void draw(bool force);
     FILE* out_;
     bool tty_ = false, open_line_ = false;

@@ -8,7 +8,8 @@
 namespace nbvh::app {
 
 void mark_floor(StudyRow& r) {
-    r.within_2x_floor = std::isfinite(r.flip) && std::isfinite(r.noise_floor) && r.flip <= 2.0 * r.noise_floor;
+    r.within_2x_floor =
+        std::isfinite(r.flip) && std::isfinite(r.noise_floor) && r.flip <= 2.0 * r.noise_floor;
     r.converged = std::isfinite(r.flip) && std::isfinite(r.noise_floor) &&
                   (r.noise_floor <= r.flip / 3.0 || r.noise_floor <= 0.005);
 }
@@ -29,9 +30,10 @@ std::vector<StudyRow> mean_over_cameras(const std::vector<StudyRow>& rows) {
         const auto& g = groups[k];
         StudyRow m = *g.front();
         m.camera = -1;
-        for (double StudyRow::*f : {&StudyRow::frame_ms, &StudyRow::classical_frame_ms, &StudyRow::ratio_to_classical,
-                                    &StudyRow::flip, &StudyRow::noise_floor, &StudyRow::flip_same_seed,
-                                    &StudyRow::flip_vs_base_cap, &StudyRow::queries_per_ray, &StudyRow::equal_time_flip}) {
+        for (double StudyRow::*f :
+             {&StudyRow::frame_ms, &StudyRow::classical_frame_ms, &StudyRow::ratio_to_classical,
+              &StudyRow::flip, &StudyRow::noise_floor, &StudyRow::flip_same_seed, &StudyRow::flip_vs_base_cap,
+              &StudyRow::queries_per_ray, &StudyRow::equal_time_flip}) {
             double sum = 0.0;
             for (const StudyRow* r : g) sum += r->*f;
             m.*f = sum / double(g.size());
@@ -46,11 +48,36 @@ std::vector<StudyRow> mean_over_cameras(const std::vector<StudyRow>& rows) {
 }
 
 std::vector<std::string> study_csv_columns() {
-    return {"scene", "config", "variant", "camera", "nodes_target", "hash_log2", "lods", "lod", "secondary_lod",
-            "max_leaves", "nodes", "memory_bytes", "resident_bytes", "triangles", "compression", "frame_ms",
-            "classical_frame_ms", "ratio_to_classical", "flip", "noise_floor", "flip_same_seed", "flip_vs_base_cap",
-            "within_2x_floor", "converged", "queries_per_ray", "equal_time_spp", "equal_time_flip", "train_seconds",
-            "final_loss", "decimation_sloppy"};
+    return {"scene",
+            "config",
+            "variant",
+            "camera",
+            "nodes_target",
+            "hash_log2",
+            "lods",
+            "lod",
+            "secondary_lod",
+            "max_leaves",
+            "nodes",
+            "memory_bytes",
+            "resident_bytes",
+            "triangles",
+            "compression",
+            "frame_ms",
+            "classical_frame_ms",
+            "ratio_to_classical",
+            "flip",
+            "noise_floor",
+            "flip_same_seed",
+            "flip_vs_base_cap",
+            "within_2x_floor",
+            "converged",
+            "queries_per_ray",
+            "equal_time_spp",
+            "equal_time_flip",
+            "train_seconds",
+            "final_loss",
+            "decimation_sloppy"};
 }
 
 namespace {
@@ -70,15 +97,36 @@ std::string study_csv(const std::vector<StudyRow>& rows, const std::string& scen
     for (size_t i = 0; i < cols.size(); ++i) out += (i ? "," : "") + cols[i];
     out += "\n";
     for (const StudyRow& r : rows) {
-        const std::vector<std::string> v = {
-            csv_text(scene), std::to_string(r.config), r.variant, r.camera < 0 ? "mean" : std::to_string(r.camera),
-            std::to_string(r.nodes_target), std::to_string(r.hash_log2), std::to_string(r.lods), std::to_string(r.lod),
-            std::to_string(r.secondary_lod), std::to_string(r.max_leaves), std::to_string(r.nodes),
-            std::to_string(r.memory_bytes), std::to_string(r.resident_bytes), std::to_string(r.triangles),
-            num(r.compression), num(r.frame_ms), num(r.classical_frame_ms), num(r.ratio_to_classical), num(r.flip),
-            num(r.noise_floor), num(r.flip_same_seed), num(r.flip_vs_base_cap), r.within_2x_floor ? "1" : "0",
-            r.converged ? "1" : "0", num(r.queries_per_ray), std::to_string(r.equal_time_spp), num(r.equal_time_flip),
-            num(r.train_seconds), num(r.final_loss), r.decimation_sloppy ? "1" : "0"};
+        const std::vector<std::string> v = {csv_text(scene),
+                                            std::to_string(r.config),
+                                            r.variant,
+                                            r.camera < 0 ? "mean" : std::to_string(r.camera),
+                                            std::to_string(r.nodes_target),
+                                            std::to_string(r.hash_log2),
+                                            std::to_string(r.lods),
+                                            std::to_string(r.lod),
+                                            std::to_string(r.secondary_lod),
+                                            std::to_string(r.max_leaves),
+                                            std::to_string(r.nodes),
+                                            std::to_string(r.memory_bytes),
+                                            std::to_string(r.resident_bytes),
+                                            std::to_string(r.triangles),
+                                            num(r.compression),
+                                            num(r.frame_ms),
+                                            num(r.classical_frame_ms),
+                                            num(r.ratio_to_classical),
+                                            num(r.flip),
+                                            num(r.noise_floor),
+                                            num(r.flip_same_seed),
+                                            num(r.flip_vs_base_cap),
+                                            r.within_2x_floor ? "1" : "0",
+                                            r.converged ? "1" : "0",
+                                            num(r.queries_per_ray),
+                                            std::to_string(r.equal_time_spp),
+                                            num(r.equal_time_flip),
+                                            num(r.train_seconds),
+                                            num(r.final_loss),
+                                            r.decimation_sloppy ? "1" : "0"};
         for (size_t i = 0; i < v.size(); ++i) out += (i ? "," : "") + v[i];
         out += "\n";
     }

@@ -81,19 +81,19 @@ struct Config {
 // Everything of one camera that every configuration compares against.
 struct CameraSide {
     Camera camera;
-    float exposure = 0.0f;              // stops of every PNG of this camera (the reference's auto exposure)
-    Image ref_px, floor_px;             // reference (ref_spp) and classical (spp, compared seed), as PNG pixels
+    float exposure = 0.0f;  // stops of every PNG of this camera (the reference's auto exposure)
+    Image ref_px, floor_px; // reference (ref_spp) and classical (spp, compared seed), as PNG pixels
     double noise_floor = 0.0, classical_ms = 0.0;
     std::unique_ptr<WavefrontRenderer> classical; // image size: reference, floor, equal-time renders
     std::map<uint32_t, double> equal_time_flip;   // classical spp -> FLIP vs the reference
 };
 
 class StudyRun {
-public:
+  public:
     explicit StudyRun(const StudyOptions& o) : o_(o), progress_(stderr) {}
     void run();
 
-private:
+  private:
     RenderOptions image_options(uint32_t spp, uint32_t seed) const {
         RenderOptions r = o_.render;
         r.spp = spp;
@@ -106,7 +106,9 @@ private:
         if (time_width_) r.width = time_width_, r.height = time_height_;
         return r;
     }
-    bool separate_timing() const { return time_width_ && (time_width_ != o_.render.width || time_height_ != o_.render.height); }
+    bool separate_timing() const {
+        return time_width_ && (time_width_ != o_.render.width || time_height_ != o_.render.height);
+    }
     double pixel_samples(uint32_t spp) const { return double(o_.render.width) * o_.render.height * spp; }
     // A hybrid row: its image (counted 1.5x a classical one), its frames, and the equal-time classical image
     // (about the hybrid's time; cached, so often free).
@@ -124,7 +126,8 @@ private:
     std::vector<Variant> variants_of(size_t config, uint32_t lods) const {
         std::vector<Variant> v;
         const uint32_t cap = o_.render.neural.max_rounds;
-        for (uint32_t l = 0; l < lods; ++l) v.push_back({"lod", int(l), int(l), cap, o_.equal_time && l == 0});
+        for (uint32_t l = 0; l < lods; ++l)
+            v.push_back({"lod", int(l), int(l), cap, o_.equal_time && l == 0});
         if (lods > 1) v.push_back({"switch", 0, int(lods - 1), cap, o_.equal_time});
         if (o_.cap_study && o_.cap_study != cap && config == configs_.size() / 2)
             v.push_back({"cap", 0, 0, o_.cap_study, false});
@@ -136,7 +139,8 @@ private:
     }
     render::RenderResult render_with(WavefrontRenderer& r, const RenderOptions& opt);
     void save(const char* name, const Image& linear, float exposure) const;
-    double time_frame(WavefrontRenderer& image_renderer, WavefrontRenderer* timing_renderer, RenderOptions opt);
+    double time_frame(WavefrontRenderer& image_renderer, WavefrontRenderer* timing_renderer,
+                      RenderOptions opt);
     void plan();
     void classical_side();
     void run_config(size_t index, const Config& c);
@@ -179,7 +183,8 @@ void StudyRun::save(const char* name, const Image& linear, float exposure) const
 
 // GPU ms of one frame (time_spp samples per pixel): median of `repeat` after a warm-up, at the timing
 // resolution (its own renderer when that differs from the image size).
-double StudyRun::time_frame(WavefrontRenderer& image_renderer, WavefrontRenderer* timing_renderer, RenderOptions opt) {
+double StudyRun::time_frame(WavefrontRenderer& image_renderer, WavefrontRenderer* timing_renderer,
+                            RenderOptions opt) {
     WavefrontRenderer& r = timing_renderer ? *timing_renderer : image_renderer;
     opt.spp = o_.time_spp;
     opt.seed = o_.render.seed;
@@ -191,15 +196,18 @@ double StudyRun::time_frame(WavefrontRenderer& image_renderer, WavefrontRenderer
 void StudyRun::plan() {
     const double cams = double(cams_.size());
     for (size_t c = 0; c < cams_.size(); ++c) {
-        progress_.plan(StudyTask::render, pixel_samples(o_.ref_spp) + pixel_samples(o_.render.spp) + timing_work());
+        progress_.plan(StudyTask::render,
+                       pixel_samples(o_.ref_spp) + pixel_samples(o_.render.spp) + timing_work());
     }
     const TrainOptions d = default_train_options(backend_);
     const double samples = double(o_.steps.value_or(d.steps)) * o_.batch.value_or(d.batch_size);
     for (size_t i = 0; i < configs_.size(); ++i) {
         progress_.plan(StudyTask::train, samples);
         for (size_t c = 0; c < cams; ++c) {
-            for (const Variant& v : variants_of(i, o_.lods)) progress_.plan(StudyTask::render, variant_work(v.equal_time));
-            if (o_.decimation) progress_.plan(StudyTask::render, pixel_samples(o_.render.spp) + timing_work());
+            for (const Variant& v : variants_of(i, o_.lods))
+                progress_.plan(StudyTask::render, variant_work(v.equal_time));
+            if (o_.decimation)
+                progress_.plan(StudyTask::render, pixel_samples(o_.render.spp) + timing_work());
         }
     }
 }
@@ -208,9 +216,10 @@ void StudyRun::classical_side() {
     const Scene& scene = ts_.scene;
     for (size_t c = 0; c < cams_.size(); ++c) {
         CameraSide& cam = cams_[c];
-        progress_.begin(StudyTask::render, pixel_samples(o_.ref_spp) + pixel_samples(o_.render.spp) + timing_work(),
-                        strfmt("camera %zu: classical reference (%u spp), noise floor (%u spp)", c, o_.ref_spp,
-                               o_.render.spp));
+        progress_.begin(StudyTask::render,
+                        pixel_samples(o_.ref_spp) + pixel_samples(o_.render.spp) + timing_work(),
+                        strfmt("camera %zu: classical reference (%u spp), noise floor (%u spp)", c,
+                               o_.ref_spp, o_.render.spp));
         RenderOptions ref = image_options(o_.ref_spp, o_.render.seed + REFERENCE_SEED_OFFSET);
         ref.neural.classical = true;
         render::validate(ref.neural, scene);
@@ -261,7 +270,8 @@ double StudyRun::equal_time(CameraSide& cam, double ratio, uint32_t* spp_out) {
     if (auto it = cam.equal_time_flip.find(spp); it != cam.equal_time_flip.end()) return it->second;
     RenderOptions opt = image_options(spp, o_.render.seed);
     opt.neural.classical = true;
-    const double flip = flip_ldr(cam.ref_px, as_png_pixels(render_with(*cam.classical, opt).image, cam.exposure)).mean;
+    const double flip =
+        flip_ldr(cam.ref_px, as_png_pixels(render_with(*cam.classical, opt).image, cam.exposure)).mean;
     cam.equal_time_flip[spp] = flip;
     return flip;
 }
@@ -277,8 +287,8 @@ void StudyRun::run_config(size_t index, const Config& c) {
     opt.seed = o_.train_seed;
     opt.threads = o_.threads;
     validate(opt);
-    const std::string label = strfmt("config %zu/%zu (nodes %u, hash 2^%u)", index + 1, configs_.size(), c.nodes,
-                                     c.hash_log2);
+    const std::string label =
+        strfmt("config %zu/%zu (nodes %u, hash 2^%u)", index + 1, configs_.size(), c.nodes, c.hash_log2);
     progress_.begin(StudyTask::train, double(opt.steps) * opt.batch_size, label + ": training");
     const TrainResult tr = [&] { // the backend (its GPU memory) is gone before the renders
         std::unique_ptr<TrainerBackend> be = make_backend(backend_, *asset_, opt);
@@ -289,16 +299,28 @@ void StudyRun::run_config(size_t index, const Config& c) {
     const NeuralModel model = make_neural_model(*asset_, tr, opt, o_.scene, ts_.source_hash);
     const render::NeuralGpuBytes bytes = render::neural_gpu_bytes(model);
     progress_.end(strfmt("%u nodes, %s, final loss %.4f, %.1f s", tr.tree.node_count(),
-                         strfmt("%.2f MiB", double(bytes.total()) / 1048576.0).c_str(), tr.log.back().loss.total,
-                         tr.seconds));
-    config_json_.push_back({{"config", index}, {"nodes_target", c.nodes}, {"hash_log2", c.hash_log2},
-                            {"nodes", tr.tree.node_count()}, {"lod_node_counts", model.lod_node_counts},
-                            {"train_seconds", tr.seconds}, {"train_steps", opt.steps}, {"train_batch", opt.batch_size},
-                            {"final_loss", tr.log.back().loss.total}, {"skipped_steps", tr.skipped_steps},
-                            {"neural_bytes", {{"total", bytes.total()}, {"grid", bytes.grid}, {"mlp", bytes.mlp},
-                                              {"mlp_transposed", bytes.mlp_transposed}, {"levels", bytes.levels},
-                                              {"nodes", bytes.nodes}, {"node_bounds", bytes.node_bounds},
-                                              {"assets", bytes.assets}, {"params", bytes.params}}}});
+                         strfmt("%.2f MiB", double(bytes.total()) / 1048576.0).c_str(),
+                         tr.log.back().loss.total, tr.seconds));
+    config_json_.push_back({{"config", index},
+                            {"nodes_target", c.nodes},
+                            {"hash_log2", c.hash_log2},
+                            {"nodes", tr.tree.node_count()},
+                            {"lod_node_counts", model.lod_node_counts},
+                            {"train_seconds", tr.seconds},
+                            {"train_steps", opt.steps},
+                            {"train_batch", opt.batch_size},
+                            {"final_loss", tr.log.back().loss.total},
+                            {"skipped_steps", tr.skipped_steps},
+                            {"neural_bytes",
+                             {{"total", bytes.total()},
+                              {"grid", bytes.grid},
+                              {"mlp", bytes.mlp},
+                              {"mlp_transposed", bytes.mlp_transposed},
+                              {"levels", bytes.levels},
+                              {"nodes", bytes.nodes},
+                              {"node_bounds", bytes.node_bounds},
+                              {"assets", bytes.assets},
+                              {"params", bytes.params}}}});
 
     // The scene as the model sees it (its asset table decides which instances are neural).
     Scene hybrid_scene = ts_.scene;
@@ -365,14 +387,15 @@ void StudyRun::run_config(size_t index, const Config& c) {
             row.flip_same_seed = flip_ldr(cam.floor_px, px).mean;
             if (v.kind == "lod" && v.lod == 0) base_px = px;
             if (v.kind == "cap" && base_px.width) row.flip_vs_base_cap = flip_ldr(base_px, px).mean;
-            if (v.equal_time) row.equal_time_flip = equal_time(cam, row.ratio_to_classical, &row.equal_time_spp);
+            if (v.equal_time)
+                row.equal_time_flip = equal_time(cam, row.ratio_to_classical, &row.equal_time_spp);
             mark_floor(row);
             if (o_.save_images && index == 0 && ci == 0 && v.kind == "lod" && v.lod == 0)
                 save("hybrid_cam0.png", res.image, cam.exposure);
             rows_.push_back(row);
-            progress_.end(strfmt("FLIP %.4f (floor %.4f%s), %.2fx classical, %.2f MiB", row.flip, row.noise_floor,
-                                 row.within_2x_floor ? ", within 2x floor" : "", row.ratio_to_classical,
-                                 double(row.memory_bytes) / 1048576.0));
+            progress_.end(strfmt("FLIP %.4f (floor %.4f%s), %.2fx classical, %.2f MiB", row.flip,
+                                 row.noise_floor, row.within_2x_floor ? ", within 2x floor" : "",
+                                 row.ratio_to_classical, double(row.memory_bytes) / 1048576.0));
         }
         if (dec) {
             progress_.begin(StudyTask::render, pixel_samples(o_.render.spp) + timing_work(),
@@ -385,7 +408,8 @@ void StudyRun::run_config(size_t index, const Config& c) {
             if (separate_timing()) {
                 RenderOptions t = timing_options();
                 t.neural.classical = true;
-                dtiming = std::make_unique<WavefrontRenderer>(*ctx_, dec->scene, *dec_accel, env_, cam.camera, t);
+                dtiming =
+                    std::make_unique<WavefrontRenderer>(*ctx_, dec->scene, *dec_accel, env_, cam.camera, t);
             }
             StudyRow row;
             row.config = int(index);
@@ -410,7 +434,8 @@ void StudyRun::run_config(size_t index, const Config& c) {
             if (o_.save_images && index == 0 && ci == 0) save("decimated_cam0.png", res.image, cam.exposure);
             rows_.push_back(row);
             progress_.end(strfmt("FLIP %.4f (floor %.4f), %.2f MiB (%+.1f %% of the model's)", row.flip,
-                                 row.noise_floor, double(dec->bytes) / 1048576.0, 100.0 * dec->relative_error()));
+                                 row.noise_floor, double(dec->bytes) / 1048576.0,
+                                 100.0 * dec->relative_error()));
         }
     }
 }
@@ -422,8 +447,11 @@ void StudyRun::write_results() const {
     write_text_atomically((fs::path(o_.out_dir) / "study.csv").string(), study_csv(all, o_.scene));
     nlohmann::json cams = nlohmann::json::array();
     for (size_t c = 0; c < cams_.size(); ++c)
-        cams.push_back({{"camera", c}, {"view", camera_string(cams_[c].camera)}, {"exposure_stops", cams_[c].exposure},
-                        {"noise_floor", cams_[c].noise_floor}, {"classical_frame_ms", cams_[c].classical_ms}});
+        cams.push_back({{"camera", c},
+                        {"view", camera_string(cams_[c].camera)},
+                        {"exposure_stops", cams_[c].exposure},
+                        {"noise_floor", cams_[c].noise_floor},
+                        {"classical_frame_ms", cams_[c].classical_ms}});
     nlohmann::json rows = nlohmann::json::array(), mean_rows = nlohmann::json::array();
     for (const StudyRow& r : rows_) rows.push_back(row_json(r));
     for (const StudyRow& r : means) mean_rows.push_back(row_json(r));
@@ -444,17 +472,31 @@ void StudyRun::write_results() const {
         {"training_backend", backend_ == BackendChoice::cuda ? "cuda" : "cpu"},
         {"training_device", train_device_},
         {"vulkan_validation", ctx_ && ctx_->validation_enabled()},
-        {"neural_meshes", {{"count", ts_.meshes.size()}, {"triangles", source_triangles_}, {"gpu_bytes", source_bytes_}}},
+        {"neural_meshes",
+         {{"count", ts_.meshes.size()}, {"triangles", source_triangles_}, {"gpu_bytes", source_bytes_}}},
         {"settings",
-         {{"width", o_.render.width}, {"height", o_.render.height}, {"spp", o_.render.spp}, {"ref_spp", o_.ref_spp},
-          {"seed", o_.render.seed}, {"reference_seed", o_.render.seed + REFERENCE_SEED_OFFSET},
-          {"max_depth", o_.render.max_depth}, {"time_spp", o_.time_spp}, {"time_width", t.width},
-          {"time_height", t.height}, {"repeat", o_.repeat}, {"max_leaves", o_.render.neural.max_rounds},
-          {"cap_study", o_.cap_study}, {"leaves_per_round", o_.render.neural.leaves_per_round},
-          {"neural_path", render::neural_path_name(neural_path_)}, {"neural_kernel", kernel_}, {"lods", o_.lods},
-          {"exposure", o_.exposure}, {"neural_scratch_bytes_per_ray",
-                                      render::neural_scratch_bytes_per_ray(o_.render.neural.leaves_per_round)}}},
-        {"flip_metric", "LDR-FLIP (ppd 67.02) of ACES-tone-mapped 8-bit sRGB images, one exposure per camera"},
+         {{"width", o_.render.width},
+          {"height", o_.render.height},
+          {"spp", o_.render.spp},
+          {"ref_spp", o_.ref_spp},
+          {"seed", o_.render.seed},
+          {"reference_seed", o_.render.seed + REFERENCE_SEED_OFFSET},
+          {"max_depth", o_.render.max_depth},
+          {"time_spp", o_.time_spp},
+          {"time_width", t.width},
+          {"time_height", t.height},
+          {"repeat", o_.repeat},
+          {"max_leaves", o_.render.neural.max_rounds},
+          {"cap_study", o_.cap_study},
+          {"leaves_per_round", o_.render.neural.leaves_per_round},
+          {"neural_path", render::neural_path_name(neural_path_)},
+          {"neural_kernel", kernel_},
+          {"lods", o_.lods},
+          {"exposure", o_.exposure},
+          {"neural_scratch_bytes_per_ray",
+           render::neural_scratch_bytes_per_ray(o_.render.neural.leaves_per_round)}}},
+        {"flip_metric",
+         "LDR-FLIP (ppd 67.02) of ACES-tone-mapped 8-bit sRGB images, one exposure per camera"},
         {"cameras", cams},
         {"configs", config_json_},
         {"rows", rows},
@@ -468,11 +510,15 @@ void StudyRun::run() {
     if (o_.out_dir.empty()) throw Error("--out DIR is required");
     if (fs::exists(o_.out_dir) && !fs::is_directory(o_.out_dir))
         throw Error(strfmt("--out '%s' is a file, not a folder", o_.out_dir.c_str()));
-    if (!fs::exists(fs::path(o_.out_dir).parent_path().empty() ? fs::path(".") : fs::path(o_.out_dir).parent_path()))
+    if (!fs::exists(fs::path(o_.out_dir).parent_path().empty() ? fs::path(".")
+                                                               : fs::path(o_.out_dir).parent_path()))
         throw Error(strfmt("--out '%s': its parent folder does not exist", o_.out_dir.c_str()));
-    if (o_.lods == 0 || o_.lods > NBVH_MAX_LODS) throw Error(strfmt("--lods must be in [1, %u]", NBVH_MAX_LODS));
-    if (o_.ref_spp < o_.render.spp) throw Error("--ref-spp must be at least --spp (the reference must be converged)");
-    if ((o_.time_width == 0) != (o_.time_height == 0)) throw Error("--time-width and --time-height go together");
+    if (o_.lods == 0 || o_.lods > NBVH_MAX_LODS)
+        throw Error(strfmt("--lods must be in [1, %u]", NBVH_MAX_LODS));
+    if (o_.ref_spp < o_.render.spp)
+        throw Error("--ref-spp must be at least --spp (the reference must be converged)");
+    if ((o_.time_width == 0) != (o_.time_height == 0))
+        throw Error("--time-width and --time-height go together");
     time_width_ = o_.time_width;
     time_height_ = o_.time_height;
     neural_path_ = render::parse_neural_path(o_.neural_path);
@@ -489,7 +535,8 @@ void StudyRun::run() {
 
     asset_ = std::make_unique<TrainingAsset>(make_training_asset(ts_.scene, ts_.meshes));
     const TrainOptions defaults = default_train_options(backend_);
-    const uint32_t default_hash = compact_hash_log2(*asset_, defaults.network, defaults.network.log2_hash_size);
+    const uint32_t default_hash =
+        compact_hash_log2(*asset_, defaults.network, defaults.network.log2_hash_size);
     for (uint32_t n : o_.nodes.empty() ? std::vector<uint32_t>{defaults.target_nodes} : o_.nodes)
         for (uint32_t h : o_.hash_log2.empty() ? std::vector<uint32_t>{default_hash} : o_.hash_log2)
             configs_.push_back({n, h});
@@ -510,9 +557,11 @@ void StudyRun::run() {
     if (backend_ == BackendChoice::cuda) train_device_ = cuda_device_name();
 #endif
     if (train_device_.empty())
-        train_device_ = backend_ == BackendChoice::cuda
-                            ? std::string("cuda")
-                            : strfmt("%u CPU threads", o_.threads ? o_.threads : std::max(1u, std::thread::hardware_concurrency()));
+        train_device_ =
+            backend_ == BackendChoice::cuda
+                ? std::string("cuda")
+                : strfmt("%u CPU threads",
+                         o_.threads ? o_.threads : std::max(1u, std::thread::hardware_concurrency()));
 
     vk::ContextOptions copt;
     copt.device = vk::parse_device_choice(o_.device);
@@ -520,11 +569,12 @@ void StudyRun::run() {
     accel_ = build_scene_accel(ts_.scene);
     const size_t variants = variants_of(0, o_.lods).size();
     plan();
-    progress_.note(strfmt("study of %s: %zu neural asset(s), %llu triangles (%.2f MiB with BLAS); %zu configuration(s) "
-                          "x %zu camera(s) x %zu variant(s); images %ux%u at %u spp, reference %u spp; training on %s",
-                          o_.scene.c_str(), ts_.meshes.size(), (unsigned long long)source_triangles_,
-                          double(source_bytes_) / 1048576.0, configs_.size(), cams_.size(), variants,
-                          o_.render.width, o_.render.height, o_.render.spp, o_.ref_spp, train_device_.c_str()));
+    progress_.note(
+        strfmt("study of %s: %zu neural asset(s), %llu triangles (%.2f MiB with BLAS); %zu configuration(s) "
+               "x %zu camera(s) x %zu variant(s); images %ux%u at %u spp, reference %u spp; training on %s",
+               o_.scene.c_str(), ts_.meshes.size(), (unsigned long long)source_triangles_,
+               double(source_bytes_) / 1048576.0, configs_.size(), cams_.size(), variants, o_.render.width,
+               o_.render.height, o_.render.spp, o_.ref_spp, train_device_.c_str()));
     const LogLevel level = log_level();
     set_log_level(LogLevel::warn); // the progress lines say what happens; renderer/trainer info is noise here
     try {
@@ -537,8 +587,9 @@ void StudyRun::run() {
             if (o_.budget_minutes > 0.0 && i > 0) {
                 const double per_config = (progress_.elapsed_seconds() - t_configs) / double(i);
                 if (progress_.elapsed_seconds() + per_config > 60.0 * o_.budget_minutes) {
-                    stop_reason_ = strfmt("time budget of %.1f min: configurations %zu..%zu not run (%.0f s each)",
-                                          o_.budget_minutes, i + 1, configs_.size(), per_config);
+                    stop_reason_ =
+                        strfmt("time budget of %.1f min: configurations %zu..%zu not run (%.0f s each)",
+                               o_.budget_minutes, i + 1, configs_.size(), per_config);
                     progress_.note("study: stopped at the " + stop_reason_);
                     break;
                 }
@@ -555,8 +606,8 @@ void StudyRun::run() {
     set_log_level(level);
     if (ctx_->validation_enabled() && ctx_->validation_message_count() > 0)
         log_warn("study: %d Vulkan validation messages", ctx_->validation_message_count());
-    progress_.note(strfmt("wrote %s/study.json and study.csv (%zu rows) in %s", o_.out_dir.c_str(), rows_.size(),
-                          strfmt("%.0f s", progress_.elapsed_seconds()).c_str()));
+    progress_.note(strfmt("wrote %s/study.json and study.csv (%zu rows) in %s", o_.out_dir.c_str(),
+                          rows_.size(), strfmt("%.0f s", progress_.elapsed_seconds()).c_str()));
 }
 
 } // namespace

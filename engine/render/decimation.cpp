@@ -33,8 +33,8 @@ Decimation decimate_to_budget(const Scene& scene, std::span<const uint32_t> mesh
         bool sloppy = false;
         for (uint32_t m : meshes) {
             const Mesh& src = scene.meshes[m];
-            const uint32_t target = uint32_t(std::clamp(double(src.triangle_count()) * ratio, 1.0,
-                                                        double(src.triangle_count())));
+            const uint32_t target =
+                uint32_t(std::clamp(double(src.triangle_count()) * ratio, 1.0, double(src.triangle_count())));
             SimplifyStats st;
             s.meshes[m] = simplify_mesh(src, target, &st);
             sloppy = sloppy || st.sloppy;

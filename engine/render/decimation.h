@@ -11,10 +11,10 @@
 namespace nbvh::render {
 
 struct Decimation {
-    Scene scene;                    // the input scene with the meshes replaced (instances unchanged)
-    uint64_t budget_bytes = 0;      // asked for
-    uint64_t bytes = 0;             // simplified meshes + BLAS (mesh_gpu_bytes), summed
-    uint64_t source_bytes = 0;      // the full meshes + BLAS
+    Scene scene;               // the input scene with the meshes replaced (instances unchanged)
+    uint64_t budget_bytes = 0; // asked for
+    uint64_t bytes = 0;        // simplified meshes + BLAS (mesh_gpu_bytes), summed
+    uint64_t source_bytes = 0; // the full meshes + BLAS
     uint64_t source_triangles = 0, triangles = 0;
     bool sloppy = false;            // some mesh needed vertex clustering (simplify.h)
     bool fits_unsimplified = false; // the full meshes already fit the budget: nothing was simplified

@@ -10,7 +10,8 @@
 namespace nbvh::render {
 
 uint64_t mesh_gpu_bytes(const Mesh& mesh, const MeshBvh& blas) {
-    return uint64_t(mesh.positions.size()) * sizeof(GpuVertex) + uint64_t(blas.triangle_count()) * sizeof(GpuTriangle) +
+    return uint64_t(mesh.positions.size()) * sizeof(GpuVertex) +
+           uint64_t(blas.triangle_count()) * sizeof(GpuTriangle) +
            uint64_t(to_gpu_layout(blas.bvh).size()) * sizeof(GpuBvhNode);
 }
 

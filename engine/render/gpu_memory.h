@@ -22,11 +22,13 @@ uint64_t mesh_gpu_bytes(const Mesh& mesh); // builds the BLAS with default_blas_
 // the wave size, not with the model.
 struct NeuralGpuBytes {
     uint64_t levels = 0, grid = 0, mlp = 0, mlp_transposed = 0; // the transposed copy feeds coopmat kernels
-    uint64_t nodes = 0;                // N-BVH nodes of every LoD and asset (GpuBvhNode)
-    std::vector<uint64_t> lod_nodes;   // ... of each LoD alone
-    uint64_t node_bounds = 0;          // two vec3 per N-BVH node
-    uint64_t assets = 0, params = 0;   // GpuNeuralAsset table, GpuNeuralParams
-    uint64_t total() const { return levels + grid + mlp + mlp_transposed + nodes + node_bounds + assets + params; }
+    uint64_t nodes = 0;              // N-BVH nodes of every LoD and asset (GpuBvhNode)
+    std::vector<uint64_t> lod_nodes; // ... of each LoD alone
+    uint64_t node_bounds = 0;        // two vec3 per N-BVH node
+    uint64_t assets = 0, params = 0; // GpuNeuralAsset table, GpuNeuralParams
+    uint64_t total() const {
+        return levels + grid + mlp + mlp_transposed + nodes + node_bounds + assets + params;
+    }
     // A model that keeps only the cut of `lod` (the others' nodes not uploaded).
     uint64_t total_for_lod(uint32_t lod) const;
 };

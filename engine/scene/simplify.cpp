@@ -66,12 +66,12 @@ Mesh simplify_mesh(const Mesh& mesh, uint32_t target_triangles, SimplifyStats* s
         const size_t target = std::max<size_t>(1, size_t(double(group_tris) * ratio + 0.5));
         dst.resize(idx.size());
         // target_error 1 = the whole mesh extent: the triangle count alone stops the collapse.
-        size_t n = meshopt_simplify(dst.data(), idx.data(), idx.size(), pos, nv, sizeof(glm::vec3), target * 3, 1.0f,
-                                    0, nullptr);
+        size_t n = meshopt_simplify(dst.data(), idx.data(), idx.size(), pos, nv, sizeof(glm::vec3),
+                                    target * 3, 1.0f, 0, nullptr);
         if (n / 3 > target + target / 50 + 1) {
             st.sloppy = true;
-            n = meshopt_simplifySloppy(dst.data(), idx.data(), idx.size(), pos, nv, sizeof(glm::vec3), target * 3,
-                                       1.0f, nullptr);
+            n = meshopt_simplifySloppy(dst.data(), idx.data(), idx.size(), pos, nv, sizeof(glm::vec3),
+                                       target * 3, 1.0f, nullptr);
         }
         indices.insert(indices.end(), dst.begin(), dst.begin() + ptrdiff_t(n));
         materials.insert(materials.end(), n / 3, material);

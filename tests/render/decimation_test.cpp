@@ -21,7 +21,8 @@ Mesh sphere(uint32_t rings, uint32_t segments) {
     m.name = "sphere";
     for (uint32_t r = 0; r <= rings; ++r)
         for (uint32_t s = 0; s <= segments; ++s) {
-            const float th = 3.14159265f * float(r) / float(rings), ph = 6.2831853f * float(s) / float(segments);
+            const float th = 3.14159265f * float(r) / float(rings),
+                        ph = 6.2831853f * float(s) / float(segments);
             const glm::vec3 p(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
             m.positions.push_back(p);
             m.normals.push_back(p);
@@ -58,7 +59,8 @@ TEST(Simplify, ReachesTheTargetPerMaterialAndDropsUnusedVertices) {
     uint32_t upper = 0;
     for (uint32_t t = 0; t < out.triangle_count(); ++t) {
         const glm::vec3 c = (out.positions[out.indices[3 * t]] + out.positions[out.indices[3 * t + 1]] +
-                             out.positions[out.indices[3 * t + 2]]) / 3.0f;
+                             out.positions[out.indices[3 * t + 2]]) /
+                            3.0f;
         if (out.triangle_material[t] == 0) {
             upper++;
             EXPECT_GT(c.y, -0.05f) << t; // material 0 stays on the upper half
@@ -91,8 +93,9 @@ TEST(Decimation, BudgetWithinFivePercentOfTheNeuralBytes) {
         ASSERT_LT(budget, full / 4) << log2;
         const render::Decimation d = render::decimate_to_budget(scene, meshes, budget);
         EXPECT_FALSE(d.fits_unsimplified);
-        EXPECT_LE(std::fabs(d.relative_error()), 0.05) << "hash 2^" << log2 << ": " << d.bytes << " bytes for a budget of "
-                                                         << budget << " (" << d.triangles << " triangles)";
+        EXPECT_LE(std::fabs(d.relative_error()), 0.05)
+            << "hash 2^" << log2 << ": " << d.bytes << " bytes for a budget of " << budget << " ("
+            << d.triangles << " triangles)";
         EXPECT_EQ(d.bytes, render::mesh_gpu_bytes(d.scene.meshes[0]));
         EXPECT_EQ(d.triangles, d.scene.meshes[0].triangle_count());
         EXPECT_LT(d.triangles, d.source_triangles);
@@ -107,8 +110,8 @@ TEST(Decimation, BudgetWithinFivePercentOfTheNeuralBytes) {
 TEST(GpuMemory, MeshBytesCountVerticesTrianglesAndBlas) {
     const Mesh m = sphere(4, 8);
     const MeshBvh blas = build_mesh_bvh(m);
-    EXPECT_EQ(render::mesh_gpu_bytes(m), m.positions.size() * 56 + m.triangle_count() * 16 +
-                                             to_gpu_layout(blas.bvh).size() * 64);
+    EXPECT_EQ(render::mesh_gpu_bytes(m),
+              m.positions.size() * 56 + m.triangle_count() * 16 + to_gpu_layout(blas.bvh).size() * 64);
 }
 
 TEST(GpuMemory, NeuralBytesPerLod) {

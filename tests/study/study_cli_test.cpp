@@ -38,7 +38,8 @@ bool is_png(const fs::path& p) {
     std::ifstream f(p, std::ios::binary);
     char sig[8] = {};
     f.read(sig, 8);
-    return f.gcount() == 8 && std::string(sig, 8) == std::string("\x89PNG\r\n\x1a\n", 8) && fs::file_size(p) > 1000;
+    return f.gcount() == 8 && std::string(sig, 8) == std::string("\x89PNG\r\n\x1a\n", 8) &&
+           fs::file_size(p) > 1000;
 }
 
 // The sweep (about a minute on lavapipe).
@@ -48,10 +49,15 @@ const Study& tiny_study() {
         st.dir = nbvh::test::temp_dir("study_tiny") / "out";
         setenv("NBVH_VALIDATION", "1", 1); // the child runs with the validation layer; any message fails
         // Frames timed at another size than the images: their own renderers.
-        st.run = run_nbvh({"study", "default", "--out", st.dir.string(), "--device", "cpu", "--backend", "cpu",
-                           "--steps", "20", "--batch", "256", "--nodes", "31,63", "--hash-log2", "12", "--lods", "2",
-                           "--threads", "2", "--cameras", "2", "--width", "64", "--height", "64", "--spp", "2",
-                           "--ref-spp", "8", "--repeat", "1", "--time-width", "32", "--time-height", "32",
+        st.run = run_nbvh({"study",        "default", "--out",         st.dir.string(),
+                           "--device",     "cpu",     "--backend",     "cpu",
+                           "--steps",      "20",      "--batch",       "256",
+                           "--nodes",      "31,63",   "--hash-log2",   "12",
+                           "--lods",       "2",       "--threads",     "2",
+                           "--cameras",    "2",       "--width",       "64",
+                           "--height",     "64",      "--spp",         "2",
+                           "--ref-spp",    "8",       "--repeat",      "1",
+                           "--time-width", "32",      "--time-height", "32",
                            "--save-images"},
                           500.0);
         unsetenv("NBVH_VALIDATION");
@@ -70,9 +76,10 @@ TEST(Study, TinySweepWritesCsvJsonAndPlots) {
     std::string header;
     std::getline(csv, header);
     const std::vector<std::string> cols = split(header);
-    for (const char* c : {"config", "variant", "camera", "nodes", "hash_log2", "lod", "memory_bytes", "frame_ms",
-                          "classical_frame_ms", "flip", "noise_floor", "within_2x_floor", "converged", "train_seconds",
-                          "equal_time_spp", "equal_time_flip", "compression", "triangles"})
+    for (const char* c :
+         {"config", "variant", "camera", "nodes", "hash_log2", "lod", "memory_bytes", "frame_ms",
+          "classical_frame_ms", "flip", "noise_floor", "within_2x_floor", "converged", "train_seconds",
+          "equal_time_spp", "equal_time_flip", "compression", "triangles"})
         EXPECT_NE(std::find(cols.begin(), cols.end(), c), cols.end()) << c << " missing in " << header;
     std::map<std::string, size_t> at;
     for (size_t i = 0; i < cols.size(); ++i) at[cols[i]] = i;
@@ -141,12 +148,15 @@ TEST(Study, TinySweepWritesCsvJsonAndPlots) {
     // The plots and the table of scripts/bench/plot_study.py.
     const fs::path python = "/usr/bin/python3"; // Debian's, with python3-matplotlib (scripts/setup.sh)
     const auto probe = nbvh::test::run_command(python, {"-c", "import matplotlib"}, 60.0);
-    if (probe.exit_code != 0) GTEST_SKIP() << "python3-matplotlib is not installed (scripts/setup.sh installs it): plots not checked";
+    if (probe.exit_code != 0)
+        GTEST_SKIP()
+            << "python3-matplotlib is not installed (scripts/setup.sh installs it): plots not checked";
     const fs::path out = nbvh::test::temp_dir("study_plots");
-    const auto r = nbvh::test::run_command(
-        python, {(nbvh::test::source_dir() / "scripts/bench/plot_study.py").string(), (s.dir / "study.json").string(),
-                 out.string()},
-        120.0);
+    const auto r =
+        nbvh::test::run_command(python,
+                                {(nbvh::test::source_dir() / "scripts/bench/plot_study.py").string(),
+                                 (s.dir / "study.json").string(), out.string()},
+                                120.0);
     ASSERT_EQ(r.exit_code, 0) << r.describe();
     for (const char* png : {"error_vs_time.png", "error_vs_memory.png", "training_vs_error.png"})
         EXPECT_TRUE(is_png(out / png)) << png;
@@ -160,11 +170,42 @@ TEST(Study, TinySweepWritesCsvJsonAndPlots) {
 // A time budget stops before a configuration that would end past it; what ran is written, marked incomplete.
 TEST(Study, BudgetStopsBetweenConfigurations) {
     const fs::path dir = nbvh::test::temp_dir("study_budget") / "out";
-    const auto r = run_nbvh({"study", "default", "--out", dir.string(), "--device", "cpu", "--backend", "cpu",
-                             "--steps", "5", "--batch", "128", "--nodes", "15,31", "--hash-log2", "10", "--lods", "1",
-                             "--threads", "2", "--cameras", "1", "--width", "16", "--height", "16", "--spp", "1",
-                             "--ref-spp", "2", "--repeat", "1", "--no-decimation", "--no-equal-time",
-                             "--budget-minutes", "0.0001"},
+    const auto r = run_nbvh({"study",
+                             "default",
+                             "--out",
+                             dir.string(),
+                             "--device",
+                             "cpu",
+                             "--backend",
+                             "cpu",
+                             "--steps",
+                             "5",
+                             "--batch",
+                             "128",
+                             "--nodes",
+                             "15,31",
+                             "--hash-log2",
+                             "10",
+                             "--lods",
+                             "1",
+                             "--threads",
+                             "2",
+                             "--cameras",
+                             "1",
+                             "--width",
+                             "16",
+                             "--height",
+                             "16",
+                             "--spp",
+                             "1",
+                             "--ref-spp",
+                             "2",
+                             "--repeat",
+                             "1",
+                             "--no-decimation",
+                             "--no-equal-time",
+                             "--budget-minutes",
+                             "0.0001"},
                             300.0);
     ASSERT_EQ(r.exit_code, 0) << r.describe();
     std::ifstream jf(dir / "study.json");
