@@ -2,7 +2,7 @@
 # As run for results/neural/ (moved from results/neural/gpu_run_*.sh; .devbin/ and build-qps-dev/ were that
 # session's ignored folders of binaries: nbvh, nbvh_cuda (CUDA build), bench_final = nbvh_bench_neural).
 # The v18 code on an H100 (device kind nvidia-h100-x1): neural queries/s (random, coherent) and the
-# 1080p hybrid vs classical frame, as on the H200 (neural_h200_v17f.sh / neural_h200_v18.sh). Writes JSON.
+# 1080p hybrid vs classical frame, as on the H200 (neural_h200_v17f.sh). Writes JSON.
 set -u
 source .device/env.sh
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
