@@ -45,18 +45,6 @@ struct RenderArgs {
     bool explain = false;
 };
 
-// --exposure: "auto" (nullopt) or stops.
-std::optional<float> parse_exposure(const std::string& text) {
-    if (text == "auto") return std::nullopt;
-    try {
-        size_t used = 0;
-        const float v = std::stof(text, &used);
-        if (used == text.size() && std::isfinite(v) && std::fabs(v) <= 24.0f) return v;
-    } catch (const std::exception&) {
-    }
-    throw Error(strfmt("--exposure '%s': expected 'auto' or a number of stops in [-24, 24]", text.c_str()));
-}
-
 // The exposure of the written image: PNG gets --exposure (auto: from the image), EXR stays linear.
 struct Exposure {
     std::string mode; // "auto", "fixed" or "none" (EXR)

@@ -14,6 +14,7 @@
 
 #include "app/commands.h"
 #include "app/output_path.h"
+#include "app/render_args.h"
 #include "app/training_scene.h"
 #include "engine/core/error.h"
 #include "engine/core/log.h"
@@ -41,13 +42,6 @@ struct TrainArgs {
     uint64_t seed = 1337;
     bool deterministic = false; // CUDA backend: order-independent gradient sums (trainer/cuda/README.md)
 };
-
-BackendChoice parse_backend(const std::string& s) {
-    if (s == "cpu") return BackendChoice::cpu;
-    if (s == "cuda") return BackendChoice::cuda;
-    if (s == "auto") return BackendChoice::automatic;
-    throw Error(strfmt("--backend must be cpu, cuda or auto (got '%s')", s.c_str()));
-}
 
 void run_train(const TrainArgs& a) {
     const BackendChoice backend = resolve_backend(parse_backend(a.backend));

@@ -1,7 +1,10 @@
 #include "app/render_args.h"
 
 #include <algorithm>
+#include <cmath>
+#include <stdexcept>
 
+#include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/scene/camera.h"
 #include "engine/scene/environment.h"
@@ -48,6 +51,24 @@ Camera choose_camera(const Scene& scene, const std::string& camera_arg, const re
     const float aspect = float(o.width) / float(std::max(1u, o.height));
     if (!camera_arg.empty()) return parse_camera(camera_arg);
     return scene.has_camera ? scene.camera : auto_frame(scene, aspect);
+}
+
+std::optional<float> parse_exposure(const std::string& text) {
+    if (text == "auto") return std::nullopt;
+    try {
+        size_t used = 0;
+        const float v = std::stof(text, &used);
+        if (used == text.size() && std::isfinite(v) && std::fabs(v) <= 24.0f) return v;
+    } catch (const std::exception&) {
+    }
+    throw Error(strfmt("--exposure '%s': expected 'auto' or a number of stops in [-24, 24]", text.c_str()));
+}
+
+BackendChoice parse_backend(const std::string& s) {
+    if (s == "cpu") return BackendChoice::cpu;
+    if (s == "cuda") return BackendChoice::cuda;
+    if (s == "auto") return BackendChoice::automatic;
+    throw Error(strfmt("--backend must be cpu, cuda or auto (got '%s')", s.c_str()));
 }
 
 } // namespace nbvh::app

@@ -1,12 +1,14 @@
 // Render options shared by the subcommands that render (nbvh render, nbvh bench): the CLI flags that
 // fill render::RenderOptions, and the environment and camera a render of a scene uses when none is given.
 #pragma once
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "engine/render/wavefront.h"
 #include "engine/scene/scene.h"
+#include "trainer/trainer.h"
 
 namespace nbvh::app {
 
@@ -25,5 +27,10 @@ inline constexpr const char* ENV_NONE = "none";
 // The view: `camera_arg` (--camera ex,ey,ez,tx,ty,tz,fov), else the scene's, else auto-framed for the
 // image aspect of `o`.
 Camera choose_camera(const Scene& scene, const std::string& camera_arg, const render::RenderOptions& o);
+
+// --exposure: "auto" (nullopt) or a number of stops in [-24, 24]; throws nbvh::Error otherwise.
+std::optional<float> parse_exposure(const std::string& text);
+// --backend: cpu, cuda or auto; throws nbvh::Error otherwise.
+BackendChoice parse_backend(const std::string& text);
 
 } // namespace nbvh::app

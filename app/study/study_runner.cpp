@@ -47,24 +47,6 @@ using render::WavefrontRenderer;
 // The reference's seed: any seed other than the compared images' (their noise must be independent).
 constexpr uint32_t REFERENCE_SEED_OFFSET = 1000003;
 
-BackendChoice parse_backend_name(const std::string& s) {
-    if (s == "cpu") return BackendChoice::cpu;
-    if (s == "cuda") return BackendChoice::cuda;
-    if (s == "auto") return BackendChoice::automatic;
-    throw Error(strfmt("--backend must be cpu, cuda or auto (got '%s')", s.c_str()));
-}
-
-std::optional<float> parse_stops(const std::string& text) {
-    if (text == "auto") return std::nullopt;
-    try {
-        size_t used = 0;
-        const float v = std::stof(text, &used);
-        if (used == text.size() && std::isfinite(v) && std::fabs(v) <= 24.0f) return v;
-    } catch (const std::exception&) {
-    }
-    throw Error(strfmt("--exposure '%s': expected 'auto' or a number of stops in [-24, 24]", text.c_str()));
-}
-
 std::string utc_now() {
     const std::time_t t = std::time(nullptr);
     std::tm tm{};
@@ -522,8 +504,8 @@ void StudyRun::run() {
     time_width_ = o_.time_width;
     time_height_ = o_.time_height;
     neural_path_ = render::parse_neural_path(o_.neural_path);
-    fixed_exposure_ = parse_stops(o_.exposure);
-    backend_ = resolve_backend(parse_backend_name(o_.backend));
+    fixed_exposure_ = parse_exposure(o_.exposure);
+    backend_ = resolve_backend(parse_backend(o_.backend));
     ts_ = load_training_scene(o_.scene, o_.neural_glob, o_.asset_glob);
     env_ = choose_environment(ts_.scene, o_.env);
     if (o_.env_rotation) env_.rotation = *o_.env_rotation * 3.14159265358979f / 180.0f;

@@ -8,24 +8,11 @@
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/scene/gltf_loader.h"
+#include "gltf_test_files.h"
 #include "scene_checks.h"
 #include "tests/support/test_support.h"
 
 namespace {
-
-std::string base64(const std::vector<uint8_t>& in) {
-    static const char* abc = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (size_t i = 0; i < in.size(); i += 3) {
-        const uint32_t n = (uint32_t(in[i]) << 16) | (i + 1 < in.size() ? uint32_t(in[i + 1]) << 8 : 0u) |
-                           (i + 2 < in.size() ? uint32_t(in[i + 2]) : 0u);
-        out += abc[(n >> 18) & 63];
-        out += abc[(n >> 12) & 63];
-        out += i + 1 < in.size() ? abc[(n >> 6) & 63] : '=';
-        out += i + 2 < in.size() ? abc[n & 63] : '=';
-    }
-    return out;
-}
 
 template <class T>
 void put(std::vector<uint8_t>& b, const T& v) {
@@ -48,7 +35,7 @@ TEST(GltfFeatures, SparseStripAndBrokenTextures) {
   "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, "normalTexture": {"index": 1}}],
   "textures": [{"source": 0}, {"source": 1}],
   "images": [{"uri": "missing_texture.png"}, {"uri": "data:image/png;base64,AAAAAAAA"}],
-  "buffers": [{"byteLength": 72, "uri": "data:application/octet-stream;base64,)" + base64(buf) + R"("}],
+  "buffers": [{"byteLength": 72, "uri": "data:application/octet-stream;base64,)" + nbvh::test::base64_of(buf) + R"("}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 8},
                   {"buffer": 0, "byteOffset": 56, "byteLength": 1}, {"buffer": 0, "byteOffset": 60, "byteLength": 12}],
   "accessors": [
@@ -80,7 +67,7 @@ TEST(GltfFeatures, AccessorBeyondBufferViewIsAnError) {
     std::vector<uint8_t> buf(36, 0);
     const std::string json = R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
   "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
-  "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,)" + base64(buf) + R"("}],
+  "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,)" + nbvh::test::base64_of(buf) + R"("}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36, "byteStride": 16}],
   "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"}]})";
     const auto path = nbvh::test::temp_dir("scene_features_bad") / "stride.gltf";
