@@ -5,6 +5,7 @@
 // bright where the tiny model is poor; dropped bad files leave the viewer running with the CLI's error
 // line in the panel; live CPU training lowers the loss and changes the image.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -40,7 +41,9 @@ fs::path find_xvfb_run() {
 // so hybrid and classical images differ visibly.
 const fs::path& tiny_model() {
     static const fs::path model = [] {
-        const fs::path m = test::temp_dir("viewer_script_model") / "tiny.nbvh";
+        // One folder per process: ctest runs this file's tests as parallel processes, and temp_dir() empties
+        // the folder it returns (a shared one lost its model to a sibling test in CI).
+        const fs::path m = test::temp_dir("viewer_script_model_" + std::to_string(::getpid())) / "tiny.nbvh";
         const RunResult r =
             run_nbvh({"train", "default", "--backend", "cpu", "--steps", "20", "--batch", "256", "--nodes", "63",
                       "--hash-log2", "12", "--lods", "2", "--threads", "2", "--out", m.string()},
