@@ -77,6 +77,7 @@ void write_stats(const std::string& path, const render::RenderStats& s, const st
         n["path"] = s.neural_path;
         n["queries"] = s.neural_queries;
         n["rounds"] = s.neural_rounds;
+        n["leaf_cap_rays"] = s.neural_leaf_cap_rays;
         n["queries_per_ray"] = s.neural_queries_per_ray();
         n["query_gpu_ms"] = s.neural_query_ms;
         n["queries_per_second"] = s.neural_queries_per_second();
@@ -130,9 +131,10 @@ void run_render(const RenderArgs& a) {
     log_info("render: %ux%u, %u spp on %s: %.1f ms GPU, %.3g rays/s, %llu non-finite pixels", s.width, s.height,
              s.spp, s.device.c_str(), s.gpu_ms, s.rays_per_second(), (unsigned long long)s.nonfinite_pixels);
     if (!s.neural_path.empty())
-        log_info("render: neural %s: %llu queries (%.2f per ray), %.3g queries/s over %.2f ms of query passes",
+        log_info("render: neural %s: %llu queries (%.2f per ray), %.3g queries/s over %.2f ms of query passes; "
+                 "%llu rays truncated by the leaf budget (--neural-max-leaves)",
                  s.neural_path.c_str(), (unsigned long long)s.neural_queries, s.neural_queries_per_ray(),
-                 s.neural_queries_per_second(), s.neural_query_ms);
+                 s.neural_queries_per_second(), s.neural_query_ms, (unsigned long long)s.neural_leaf_cap_rays);
     Exposure exposure{"none", 0.0f};
     if (is_exr_path(a.out)) {
         save_exr(a.out, convert_channels(result.image, 3));

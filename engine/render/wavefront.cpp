@@ -351,17 +351,18 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
     // The GPU's statistics counters are 32-bit and wrap within a long render (a 1080p frame at 4096 spp
     // traces ~1e10 rays): they are read after every submission (each adds far less than 2^32) and the
     // wrapped differences summed in 64 bits.
-    uint64_t totals[6] = {0, 0, 0, 0, 0, 0};
-    uint32_t last[6] = {0, 0, 0, 0, 0, 0};
+    uint64_t totals[7] = {0, 0, 0, 0, 0, 0, 0};
+    uint32_t last[7] = {0, 0, 0, 0, 0, 0, 0};
     auto tally = [&] {
         const GpuQueueCounters c = buffers_[NB_BIND_COUNTERS].download<GpuQueueCounters>(1)[0];
-        uint32_t now[6] = {c.rays_primary, c.rays_secondary, c.rays_shadow, c.nonfinite_samples, 0, 0};
+        uint32_t now[7] = {c.rays_primary, c.rays_secondary, c.rays_shadow, c.nonfinite_samples, 0, 0, 0};
         if (neural_) {
             const GpuNeuralCounters nc = buffers_[NB_BIND_NEURAL_COUNTERS].download<GpuNeuralCounters>(1)[0];
             now[4] = nc.queries_total;
             now[5] = nc.rounds;
+            now[6] = nc.leaf_cap_rays;
         }
-        for (int k = 0; k < 6; ++k) {
+        for (int k = 0; k < 7; ++k) {
             totals[k] += uint32_t(now[k] - last[k]);
             last[k] = now[k];
         }
@@ -404,6 +405,7 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
         s.neural_path = neural_->kernel().describe();
         s.neural_queries = totals[4];
         s.neural_rounds = totals[5];
+        s.neural_leaf_cap_rays = totals[6];
         for (const auto& [name, ms] : pass_ms)
             if (name == PASS_SHADERS[NEURAL_QUERY]) s.neural_query_ms += ms;
     }

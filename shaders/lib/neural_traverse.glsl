@@ -108,7 +108,11 @@ uint nb_nl_want(GpuNeuralRayState st) {
 bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, inout GpuNeuralRayState st) {
     uint n = 0u;
     while (n < g_nl_cand_n && g_nl_cand_t[n] < limit) n += 1u;
-    if (n == 0u || st.rounds >= neural_params.max_rounds) return false;
+    if (n == 0u) return false;
+    if (st.rounds >= neural_params.max_rounds) { // a leaf in front of the best hit, no budget left: truncated
+        atomicAdd(neural_counters.leaf_cap_rays, 1u);
+        return false;
+    }
     uint k = atomicAdd(counters.pending_count, n);
     for (uint j = 0u; j < n; ++j) {
         GpuPendingLeaf pl;
@@ -128,7 +132,9 @@ bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, inout GpuN
     st.key_leaf = g_nl_cand_leaf[n - 1u];
     // Fewer than g_nl_want queued: the candidate list was not full (no leaf in front of the limit was
     // left out) or a candidate lay behind the limit (so do all later ones). Either way no leaf remains.
-    bool last = n < g_nl_want || st.rounds + n >= neural_params.max_rounds;
+    // A ray whose budget this group spends is resumed once more (not finished here), so that a leaf left
+    // in front of its best hit is seen and counted (leaf_cap_rays) rather than silently dropped.
+    bool last = n < g_nl_want;
     st.status = last ? NB_NRAY_PENDING_LAST : NB_NRAY_PENDING;
     st.rounds += n;
     return true;

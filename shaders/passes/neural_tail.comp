@@ -58,7 +58,11 @@ void main() {
             nb_nl_begin(st, lod, 1u);
             g_nl_skip_triangles = true;
             nb_trace(org, dir, tmin, limit, shadow);
-            found = g_nl_cand_n > 0u && g_nl_cand_t[0] < limit && st.rounds < neural_params.max_rounds;
+            found = g_nl_cand_n > 0u && g_nl_cand_t[0] < limit;
+            if (found && st.rounds >= neural_params.max_rounds) { // truncated by the leaf budget
+                atomicAdd(neural_counters.leaf_cap_rays, 1u);
+                found = false;
+            }
         }
         if (!found) {
             if (shadow) st.status = NB_NRAY_DONE;

@@ -137,7 +137,8 @@ NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 64, "GpuNeuralParams layout");
 struct GpuNeuralCounters {
     uint pending_active;  // pairs the current neural_query dispatch processes
     uint queries_total;   // statistics: queries of the render (path and shadow rays)
-    uint shadow_queries;  // reserved (shadow-ray queries are counted in queries_total)
+    uint leaf_cap_rays;   // statistics: rays (path and shadow) left with a leaf in front of their best hit
+                          // when their leaf budget (max_rounds) was spent: truncated by the cap
     uint rounds;          // statistics: rounds with at least one pair
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralCounters) == 16, "GpuNeuralCounters layout");

@@ -43,7 +43,8 @@ struct Rendered {
 
 Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPath::scalar, float threshold = 0.5f,
                       uint32_t lod = 0, int32_t secondary_lod = -1, uint32_t batched_rounds = 256,
-                      uint32_t leaves_per_round = NeuralRenderOptions{}.leaves_per_round) {
+                      uint32_t leaves_per_round = NeuralRenderOptions{}.leaves_per_round,
+                      uint32_t max_leaves = NeuralRenderOptions{}.max_rounds) {
     vk::ContextOptions co;
     co.device = vk::DeviceChoice::cpu;
     co.validation = true;
@@ -64,6 +65,7 @@ Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPat
     o.neural.secondary_lod = secondary_lod;
     o.neural.batched_rounds = batched_rounds;
     o.neural.leaves_per_round = leaves_per_round;
+    o.neural.max_rounds = max_leaves;
     if (hybrid) o.neural.model = &f.model;
     else o.neural.classical = true;
     WavefrontRenderer r(ctx, f.scene, accel, default_sky(), cam, o);
@@ -137,6 +139,28 @@ TEST(HybridRender, TailPassMatchesBatchedRounds) {
     EXPECT_LT(f0, 1e-3f);
     EXPECT_EQ(all_batched.stats.neural_queries, one.stats.neural_queries);
     EXPECT_EQ(all_batched.stats.neural_queries, tail.stats.neural_queries);
+}
+
+// The leaf-cap counter (RenderStats::neural_leaf_cap_rays) counts rays truncated by their leaf budget:
+// with one leaf per ray the bunny's grazing and silhouette rays (several leaves along them) are cut;
+// the same rays are counted whether the batched rounds or the tail pass find the leaf left over; with a
+// budget no ray reaches, none is counted and the image is that of the default budget or better.
+TEST(HybridRender, LeafCapCounterCountsTruncatedRays) {
+    NBVH_REQUIRE_SHARED();
+    const Fixture& f = trained_bunny();
+    const Rendered cap1 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 1, 1);
+    const Rendered cap1_tail = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 0, 1, 1);
+    const Rendered cap256 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 4, 256);
+    EXPECT_EQ(cap1.validation + cap1_tail.validation + cap256.validation, 0);
+    std::printf("leaf-cap rays: budget 1: %llu (tail: %llu), budget 256: %llu of %llu rays\n",
+                (unsigned long long)cap1.stats.neural_leaf_cap_rays,
+                (unsigned long long)cap1_tail.stats.neural_leaf_cap_rays,
+                (unsigned long long)cap256.stats.neural_leaf_cap_rays, (unsigned long long)cap256.stats.rays_total());
+    EXPECT_GT(cap1.stats.neural_leaf_cap_rays, 0u);
+    EXPECT_EQ(cap1.stats.neural_leaf_cap_rays, cap1_tail.stats.neural_leaf_cap_rays);
+    EXPECT_EQ(cap1.stats.neural_queries, cap1_tail.stats.neural_queries);
+    EXPECT_EQ(cap256.stats.neural_leaf_cap_rays, 0u);
+    EXPECT_LT(cap1.stats.neural_leaf_cap_rays, cap1.stats.rays_total());
 }
 
 // Several leaves per ray per round (speculative queries of the next leaves in key order) pick the same
