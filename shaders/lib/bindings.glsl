@@ -25,10 +25,10 @@ layout(push_constant, scalar) uniform PassConstantsBlock { GpuPassConstants pc; 
 
 layout(set = 0, binding = NB_BIND_PARAMS, scalar) readonly buffer ParamsBuffer { GpuFrameParams params; };
 layout(set = 0, binding = NB_BIND_COUNTERS, scalar) coherent buffer CountersBuffer { GpuQueueCounters counters; };
-layout(set = 0, binding = NB_BIND_TLAS_NODES, scalar) readonly buffer TlasBuffer { GpuBvhNode tlas_nodes[]; };
-layout(set = 0, binding = NB_BIND_BLAS_NODES, scalar) readonly buffer BlasBuffer { GpuBvhNode blas_nodes[]; };
-layout(set = 0, binding = NB_BIND_INSTANCES, scalar) readonly buffer InstanceBuffer { GpuInstance instances[]; };
-layout(set = 0, binding = NB_BIND_TRIANGLES, scalar) readonly buffer TriangleBuffer { GpuTriangle triangles[]; };
+layout(set = 0, binding = NB_BIND_TLAS_NODES, std430) readonly buffer TlasBuffer { GpuBvhNode tlas_nodes[]; };
+layout(set = 0, binding = NB_BIND_BLAS_NODES, std430) readonly buffer BlasBuffer { GpuBvhNode blas_nodes[]; };
+layout(set = 0, binding = NB_BIND_INSTANCES, std430) readonly buffer InstanceBuffer { GpuInstance instances[]; };
+layout(set = 0, binding = NB_BIND_TRIANGLES, std430) readonly buffer TriangleBuffer { GpuTriangle triangles[]; };
 layout(set = 0, binding = NB_BIND_VERTICES, scalar) readonly buffer VertexBuffer { GpuVertex vertices[]; };
 layout(set = 0, binding = NB_BIND_MATERIALS, scalar) readonly buffer MaterialBuffer { GpuMaterial materials[]; };
 layout(set = 0, binding = NB_BIND_TEXTURE_INFOS, scalar) readonly buffer TextureInfoBuffer { GpuTextureInfo texture_infos[]; };

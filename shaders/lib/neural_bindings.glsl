@@ -16,7 +16,7 @@ layout(set = 0, binding = NB_BIND_NEURAL_MLP_T, scalar) readonly buffer NeuralMl
 #else
 layout(set = 0, binding = NB_BIND_NEURAL_MLP, scalar) readonly buffer NeuralMlpBuffer { uint neural_mlp[]; };
 #endif
-layout(set = 0, binding = NB_BIND_NBVH_NODES, scalar) readonly buffer NbvhNodeBuffer { GpuBvhNode nbvh_nodes[]; };
+layout(set = 0, binding = NB_BIND_NBVH_NODES, std430) readonly buffer NbvhNodeBuffer { GpuBvhNode nbvh_nodes[]; };
 // Object-space bounds of every N-BVH node: lo at 2i, hi at 2i + 1.
 layout(set = 0, binding = NB_BIND_NBVH_BOUNDS, scalar) readonly buffer NbvhBoundsBuffer { vec3 nbvh_bounds[]; };
 layout(set = 0, binding = NB_BIND_NEURAL_STATE, scalar) buffer NeuralStateBuffer { GpuNeuralRayState neural_state[]; };

@@ -31,6 +31,7 @@ uint g_alpha_seed;     // per-ray random bits for stochastic alpha blending
 uint g_cur_instance;   // instance whose BLAS is being traversed
 vec3 g_obj_org;        // the ray in that instance's object space
 vec3 g_obj_dir;
+NbRayShear g_obj_shear; // nb_ray_shear(g_obj_dir): the per-ray part of the triangle test
 
 // Iterative nearest-first traversal of one two-child BVH. NODES: node array; ROOT: root node index
 // (an interior node); ORG, INV_DIR: the ray in the tree's space; LEAF(first, count): the leaf handler.
@@ -96,7 +97,7 @@ void nb_triangle_leaf(uint first, uint count) {
         GpuTriangle tri = triangles[tri_index];
         vec3 p0 = vertices[tri.v0].position, p1 = vertices[tri.v1].position, p2 = vertices[tri.v2].position;
         float t, u, v;
-        if (!nb_intersect_triangle(g_obj_org, g_obj_dir, p0, p1, p2, g_tmin, g_tmax, t, u, v)) continue;
+        if (!nb_intersect_triangle_sheared(g_obj_org, g_obj_shear, p0, p1, p2, g_tmin, g_tmax, t, u, v)) continue;
         // glTF doubleSided false: every ray (camera, continuation, shadow) passes through back faces, so
         // NEE and BSDF sampling see the same scene.
         if (NB_HAS_SINGLE_SIDED && materials[tri.material].double_sided == 0u && nb_back_facing(p0, p1, p2, g_obj_dir))
@@ -118,6 +119,7 @@ void nb_traverse_triangle_instance(uint instance) {
     g_cur_instance = instance;
     g_obj_org = nb_xform_point(inst.world_to_object, g_org);
     g_obj_dir = nb_xform_vector(inst.world_to_object, g_dir);
+    if (!nb_ray_shear(g_obj_dir, g_obj_shear)) return; // a zero direction hits no triangle
     vec3 inv_dir = nb_safe_inv_dir(g_obj_dir);
     NB_TRAVERSE_BVH(blas_nodes, inst.blas_root, g_obj_org, inv_dir, nb_triangle_leaf)
 }

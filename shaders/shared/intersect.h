@@ -47,21 +47,21 @@ NB_FN vec3 nb_safe_inv_dir(vec3 dir) {
 // with the origin in its plane counts) and empties it otherwise. This avoids 0 * inf = NaN, which
 // otherwise appears exactly for axis-parallel rays starting on a face or in a flat box's plane.
 NB_FN void nb_clip_slab(float o, float inv, float lo, float hi, NB_INOUT(float) t_near, NB_INOUT(float) t_far) {
-    if (abs(inv) >= NB_INF) {
-        if (o < lo || o > hi) { t_near = NB_INF; t_far = -NB_INF; }
-        return;
-    }
+    // Branch-free (selects only: traversal tests two boxes per node): both distances are computed
+    // even for a parallel axis, where inv = +-NB_INF is finite, so they are +-inf or 0, never NaN.
     float t0 = (lo - o) * inv;
     float t1 = (hi - o) * inv;
     // Ternaries instead of min/max: with a NaN (only from a NaN ray) tn <= tf below is false.
     float tn = t0 < t1 ? t0 : t1;
     float tf = t0 < t1 ? t1 : t0;
-    if (!(tn <= tf)) { t_near = NB_INF; t_far = -NB_INF; return; }
+    bool parallel = abs(inv) >= NB_INF;
+    // A parallel axis keeps the interval when the origin lies in the closed slab (a NaN origin does not).
+    bool keep = parallel ? (o >= lo && o <= hi) : (tn <= tf);
     // Widen by NB_SLAB_SLACK (multiplicative: infinities stay infinite, never NaN).
     tn = tn * (tn > 0.0f ? (1.0f - NB_SLAB_SLACK) : (1.0f + NB_SLAB_SLACK));
     tf = tf * (tf < 0.0f ? (1.0f - NB_SLAB_SLACK) : (1.0f + NB_SLAB_SLACK));
-    t_near = max(t_near, tn);
-    t_far = min(t_far, tf);
+    t_near = !keep ? NB_INF : (parallel ? t_near : max(t_near, tn));
+    t_far = !keep ? -NB_INF : (parallel ? t_far : min(t_far, tf));
 }
 
 // Ray/box interval clipped to [tmin, tmax]; tmin may be -NB_INF (the neural query clips a ray to a
@@ -96,21 +96,42 @@ NB_FN bool nb_intersect_aabb(vec3 org, vec3 inv_dir, vec3 lo, vec3 hi, float tmi
 // vertices; the sheared det alone can round to non-zero for those), rays in the triangle's plane
 // (det == 0) and zero directions never hit.
 // Outputs are written only on a hit; the hit requires tmin <= t <= tmax.
-NB_FN bool nb_intersect_triangle(vec3 org, vec3 dir, vec3 v0, vec3 v1, vec3 v2, float tmin, float tmax,
-                                 NB_OUT(float) t, NB_OUT(float) u, NB_OUT(float) v) {
-    // Permute so that z is the dominant direction axis; swap x/y to keep the winding when dir.z < 0.
-    vec3 n = cross(v1 - v0, v2 - v0);
-    if (n.x == 0.0f && n.y == 0.0f && n.z == 0.0f) return false;
+//
+// The per-ray part (dominant axis, shear) depends on the direction only: traversal computes it once per
+// ray and object space (nb_ray_shear) and tests each triangle with nb_intersect_triangle_sheared.
+struct NbRayShear {
+    int kx;
+    int ky;
+    int kz;
+    float sx;
+    float sy;
+    float sz;
+};
+
+// Permute so that z is the dominant direction axis; swap x/y to keep the winding when dir.z < 0.
+// False for a zero (or NaN) direction, which hits nothing.
+NB_FN bool nb_ray_shear(vec3 dir, NB_OUT(NbRayShear) s) {
     vec3 ad = abs(dir);
     int kz = (ad.x > ad.y) ? ((ad.x > ad.z) ? 0 : 2) : ((ad.y > ad.z) ? 1 : 2);
     int kx = (kz == 2) ? 0 : kz + 1;
     int ky = (kx == 2) ? 0 : kx + 1;
     float dz = dir[kz];
-    if (!(abs(dz) > 0.0f)) return false; // zero (or NaN) direction
     if (dz < 0.0f) { int tmp = kx; kx = ky; ky = tmp; }
-    float sx = dir[kx] / dz;
-    float sy = dir[ky] / dz;
-    float sz = 1.0f / dz;
+    s.kx = kx;
+    s.ky = ky;
+    s.kz = kz;
+    s.sx = dir[kx] / dz;
+    s.sy = dir[ky] / dz;
+    s.sz = 1.0f / dz;
+    return abs(dz) > 0.0f;
+}
+
+NB_FN bool nb_intersect_triangle_sheared(vec3 org, NbRayShear s, vec3 v0, vec3 v1, vec3 v2, float tmin, float tmax,
+                                         NB_OUT(float) t, NB_OUT(float) u, NB_OUT(float) v) {
+    vec3 n = cross(v1 - v0, v2 - v0);
+    if (n.x == 0.0f && n.y == 0.0f && n.z == 0.0f) return false;
+    int kx = s.kx, ky = s.ky, kz = s.kz;
+    float sx = s.sx, sy = s.sy, sz = s.sz;
 
     // Vertices relative to the origin, sheared so the ray becomes the +z axis.
     vec3 a = v0 - org;
@@ -135,6 +156,13 @@ NB_FN bool nb_intersect_triangle(vec3 org, vec3 dir, vec3 v0, vec3 v1, vec3 v2, 
     u = clamp(e1 * inv_det, 0.0f, 1.0f);
     v = clamp(e2 * inv_det, 0.0f, 1.0f);
     return true;
+}
+
+NB_FN bool nb_intersect_triangle(vec3 org, vec3 dir, vec3 v0, vec3 v1, vec3 v2, float tmin, float tmax,
+                                 NB_OUT(float) t, NB_OUT(float) u, NB_OUT(float) v) {
+    NbRayShear s;
+    if (!nb_ray_shear(dir, s)) return false;
+    return nb_intersect_triangle_sheared(org, s, v0, v1, v2, tmin, tmax, t, u, v);
 }
 
 // Back face of a single-sided triangle (glTF material doubleSided false: back faces are culled): the ray

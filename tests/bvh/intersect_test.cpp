@@ -277,4 +277,67 @@ TEST(Intersect, SafeInverseDirection) {
     (void)INF;
 }
 
+// The branch-free slab (selects only, both distances computed on a parallel axis too): a parallel axis
+// with the origin on the slab's face, inside, outside, or NaN; with the safe inverse (+-NB_INF, finite)
+// and IEEE infinities (where (lo - o) * inf is NaN for an origin on the face and must be discarded).
+TEST(Intersect, ParallelAxisSelectsNeverLeakNaN) {
+    const float nan = std::nanf("");
+    for (bool safe : {true, false}) {
+        float tn, tf;
+        // On the face x = lo, parallel to x: inside the closed slab.
+        EXPECT_TRUE(box(vec3(-1.0f, 0.0f, -5.0f), vec3(0.0f, 0.0f, 1.0f), vec3(-1.0f), vec3(1.0f), 0.0f, NB_INF, tn, tf, safe));
+        EXPECT_LE(tn, 4.0f); // widened by NB_SLAB_SLACK
+        EXPECT_GT(tn, 3.9999f);
+        // On the far face x = hi, and outside by one ulp.
+        EXPECT_TRUE(box(vec3(1.0f, 0.0f, -5.0f), vec3(0.0f, 0.0f, 1.0f), vec3(-1.0f), vec3(1.0f), 0.0f, NB_INF, tn, tf, safe));
+        EXPECT_FALSE(box(vec3(std::nextafter(1.0f, 2.0f), 0.0f, -5.0f), vec3(0.0f, 0.0f, 1.0f), vec3(-1.0f), vec3(1.0f),
+                         0.0f, NB_INF, tn, tf, safe));
+        // Parallel to two axes, in a flat box's plane.
+        EXPECT_TRUE(box(vec3(0.0f, 2.0f, -5.0f), vec3(0.0f, 0.0f, 1.0f), vec3(-1.0f, 2.0f, -1.0f), vec3(1.0f, 2.0f, 1.0f),
+                        0.0f, NB_INF, tn, tf, safe));
+    }
+    // A NaN origin component on a parallel axis: no hit (no NaN read as "inside").
+    float tn;
+    EXPECT_FALSE(nb_intersect_aabb(vec3(nan, 0.0f, -5.0f), nb_safe_inv_dir(vec3(0.0f, 0.0f, 1.0f)), vec3(-1.0f), vec3(1.0f),
+                                   0.0f, NB_INF, tn));
+}
+
+// Traversal computes the ray's shear once (nb_ray_shear) and tests triangles with
+// nb_intersect_triangle_sheared: bit-identical to nb_intersect_triangle, for every dominant axis and
+// sign, axis-parallel and grazing directions, far-from-origin rays; zero and NaN directions have no shear.
+TEST(Intersect, ShearedTriangleTestMatchesPerCallTest) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> U(-1.0f, 1.0f);
+    const vec3 axes[] = {vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1)};
+    int hits = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const float scale = (i % 3 == 0) ? 1.0e4f : 1.0f;
+        const vec3 off = (i % 5 == 0) ? vec3(3.0e6f, -2.0e6f, 1.0e6f) : vec3(0.0f);
+        vec3 v0 = off + scale * vec3(U(rng), U(rng), U(rng)), v1 = off + scale * vec3(U(rng), U(rng), U(rng)),
+             v2 = off + scale * vec3(U(rng), U(rng), U(rng));
+        vec3 o = off + scale * 3.0f * vec3(U(rng), U(rng), U(rng));
+        vec3 target = (v0 + v1 + v2) / 3.0f + 0.3f * scale * vec3(U(rng), U(rng), U(rng));
+        vec3 d = (i % 7 == 0) ? axes[i % 6] : target - o;
+        if (i % 11 == 0) d.y = 0.0f; // parallel to an axis
+        float t0 = -1, u0 = -1, w0 = -1, t1 = -2, u1 = -2, w1 = -2;
+        NbRayShear sh;
+        const bool valid = nb_ray_shear(d, sh);
+        const bool h0 = nb_intersect_triangle(o, d, v0, v1, v2, 0.0f, NB_INF, t0, u0, w0);
+        const bool h1 = valid && nb_intersect_triangle_sheared(o, sh, v0, v1, v2, 0.0f, NB_INF, t1, u1, w1);
+        ASSERT_EQ(h0, h1) << i;
+        if (h0) {
+            ++hits;
+            EXPECT_EQ(t0, t1);
+            EXPECT_EQ(u0, u1);
+            EXPECT_EQ(w0, w1);
+        }
+    }
+    EXPECT_GT(hits, 2000);
+    NbRayShear sh;
+    EXPECT_FALSE(nb_ray_shear(vec3(0.0f), sh));
+    float t, u, v;
+    EXPECT_FALSE(nb_intersect_triangle(vec3(0, 0, -1), vec3(std::nanf("")), vec3(-1, -1, 0), vec3(1, -1, 0),
+                                       vec3(0, 1, 0), 0.0f, NB_INF, t, u, v));
+}
+
 } // namespace
