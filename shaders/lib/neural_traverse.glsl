@@ -151,6 +151,12 @@ void nb_nl_take_hit(inout GpuNeuralRayState st, float t, vec3 normal, vec3 albed
     }
 }
 
+// Whether a leaf can remain in front of `limit` after the ray's last queued key: the leaves not yet
+// queued have keys above (key_t, key_instance, key_leaf), so entry distances >= key_t, and a leaf is
+// queued only when its key lies in front of the limit. When the best hit is at or before key_t, the
+// re-traversal would find nothing: the ray is finished without it (same decisions, same image).
+bool nb_nl_may_have_more(GpuNeuralRayState st, float limit) { return st.key_t < limit; }
+
 bool nb_nl_is_pending(uint status) { return status == NB_NRAY_PENDING || status == NB_NRAY_PENDING_LAST; }
 
 // The resumed traversal of a ray: the results of its `group` pairs from pending slot `slot` on.

@@ -29,7 +29,10 @@ void main() {
         if (!nb_nl_is_pending(st.status)) return;
         bool last = st.status == NB_NRAY_PENDING_LAST;
         nb_nl_reduce_group(slot, pl.group, st);
-        if (last || st.best_t < NB_INF) { // an occluder found, or no leaf left: done without re-traversal
+        // An occluder found, or no leaf left (also when the last key lies at or beyond the shadow ray's
+        // end): done without re-traversal.
+        if (last || st.best_t < NB_INF ||
+            !nb_nl_may_have_more(st, uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, pl.ray - cap)))) {
             st.status = NB_NRAY_DONE;
             neural_state[cap + i] = st;
             return;

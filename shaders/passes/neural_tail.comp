@@ -54,7 +54,7 @@ void main() {
         }
         float limit = shadow ? tmax : min(st.tri_t, st.best_t);
         bool found = false;
-        if (!last) { // (only the first iteration can see last == true: it returns below)
+        if (!last && nb_nl_may_have_more(st, limit)) { // (only the first iteration can see last == true)
             nb_nl_begin(st, lod, 1u);
             g_nl_skip_triangles = true;
             nb_trace(org, dir, tmin, limit, shadow);

@@ -34,7 +34,7 @@ void main() {
         if (!nb_nl_is_pending(st.status)) return;
         bool last = st.status == NB_NRAY_PENDING_LAST;
         nb_nl_reduce_group(slot, pl.group, st);
-        if (last) { // nothing left in front: no re-traversal
+        if (last || !nb_nl_may_have_more(st, min(st.tri_t, st.best_t))) { // nothing left in front: no re-traversal
             nb_nl_finish_path(i, st);
             neural_state[i] = st;
             return;
