@@ -33,7 +33,7 @@ std::vector<StudyRow> mean_over_cameras(const std::vector<StudyRow>& rows) {
         for (double StudyRow::*f :
              {&StudyRow::frame_ms, &StudyRow::classical_frame_ms, &StudyRow::ratio_to_classical,
               &StudyRow::flip, &StudyRow::noise_floor, &StudyRow::flip_same_seed, &StudyRow::flip_vs_base_cap,
-              &StudyRow::queries_per_ray, &StudyRow::equal_time_flip}) {
+              &StudyRow::queries_per_ray, &StudyRow::leaf_cap_fraction, &StudyRow::equal_time_flip}) {
             double sum = 0.0;
             for (const StudyRow* r : g) sum += r->*f;
             m.*f = sum / double(g.size());
@@ -73,6 +73,7 @@ std::vector<std::string> study_csv_columns() {
             "within_2x_floor",
             "converged",
             "queries_per_ray",
+            "leaf_cap_fraction",
             "equal_time_spp",
             "equal_time_flip",
             "train_seconds",
@@ -122,6 +123,7 @@ std::string study_csv(const std::vector<StudyRow>& rows, const std::string& scen
                                             r.within_2x_floor ? "1" : "0",
                                             r.converged ? "1" : "0",
                                             num(r.queries_per_ray),
+                                            num(r.leaf_cap_fraction),
                                             std::to_string(r.equal_time_spp),
                                             num(r.equal_time_flip),
                                             num(r.train_seconds),
@@ -158,6 +160,7 @@ nlohmann::json row_json(const StudyRow& r) {
             {"within_2x_floor", r.within_2x_floor},
             {"converged", r.converged},
             {"queries_per_ray", jnum(r.queries_per_ray)},
+            {"leaf_cap_fraction", jnum(r.leaf_cap_fraction)},
             {"equal_time_spp", r.equal_time_spp},
             {"equal_time_flip", jnum(r.equal_time_flip)},
             {"train_seconds", jnum(r.train_seconds)},

@@ -363,6 +363,9 @@ void StudyRun::run_config(size_t index, const Config& c) {
             const render::RenderResult res = render_with(hybrid, vo);
             const Image px = as_png_pixels(res.image, cam.exposure);
             row.queries_per_ray = res.stats.neural_queries_per_ray();
+            row.leaf_cap_fraction = res.stats.rays_total() ? double(res.stats.neural_leaf_cap_rays) /
+                                                                 double(res.stats.rays_total())
+                                                           : 0.0;
             kernel_ = res.stats.neural_path;
             row.flip = flip_ldr(cam.ref_px, px).mean;
             row.noise_floor = cam.noise_floor;

@@ -154,6 +154,10 @@ def fmt(v, spec):
     return "-" if v is None else format(v, spec)
 
 
+def pct(v):  # a share as a percentage, "-" when absent (studies written before the column existed)
+    return "-" if v is None else f"{100.0 * v:.3g} %"
+
+
 def table(study):
     s = study["settings"]
     cl = rows_of(study, "classical")
@@ -174,9 +178,9 @@ def table(study):
                   f"reference) **{c['flip']:.4f}**" +
                   ("" if c["converged"] else " (larger than the 0.005 the issue asks: rows whose FLIP is under 3x it "
                                               "are not converged)") + ".", ""]
-    lines += ["| nodes | hash | LoD | memory MiB | vs mesh+BLAS | training s | frame ms | x classical | queries/ray | FLIP | "
+    lines += ["| nodes | hash | LoD | memory MiB | vs mesh+BLAS | training s | frame ms | x classical | queries/ray | rays capped | FLIP | "
               "decimated FLIP (equal memory) | classical FLIP (equal time, spp) |",
-              "| ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
+              "| ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
     dec = {r["config"]: r for r in rows_of(study, "decimated")}
     for r in sorted(rows_of(study, "lod") + rows_of(study, "switch") + rows_of(study, "cap"),
                     key=lambda r: (r["config"], r["variant"] != "lod", r["lod"], r["secondary_lod"])):
@@ -189,13 +193,14 @@ def table(study):
         lines.append(
             f"| {r['nodes']} | 2^{r['hash_log2']} | {lod} | {r['memory_bytes'] / MIB:.2f} | {fmt(r['compression'], '.1f')}x | "
             f"{fmt(r['train_seconds'], '.1f')} | {fmt(r['frame_ms'], '.3f')} | {fmt(r['ratio_to_classical'], '.2f')} | "
-            f"{fmt(r['queries_per_ray'], '.2f')} | {fmt(r['flip'], '.4f')}{mark} | "
+            f"{fmt(r['queries_per_ray'], '.2f')} | {pct(r.get('leaf_cap_fraction'))} | {fmt(r['flip'], '.4f')}{mark} | "
             + (f"{d['flip']:.4f} ({d['triangles']} tris)" if d else "") + " | "
             + (f"{r['equal_time_flip']:.4f} ({r['equal_time_spp']})" if r.get("equal_time_flip") is not None else "")
             + " |")
     lines += ["", "The raised leaf budget row: how much the default per-ray budget changes the image (same seed and spp as "
               "LoD 0, so noise cancels) and what more leaves cost in time; its extra queries per ray are the leaves "
-              "the default budget cuts off.", "", "`*`: within twice the noise floor (not distinguishable from noise at this spp). Memory: the model with "
+              "the default budget cuts off. Rays capped: the share of path and shadow rays that the leaf budget left with a "
+              "leaf in front of their best hit.", "", "`*`: within twice the noise floor (not distinguishable from noise at this spp). Memory: the model with "
               "only this LoD's nodes (grid, MLP and its transposed copy, level table, nodes and their bounds, asset "
               "table); every LoD resident: see study.json `resident_bytes`.", ""]
     return "\n".join(lines)

@@ -101,6 +101,8 @@ TEST(Study, TinySweepWritesCsvJsonAndPlots) {
             EXPECT_GT(num(f[at["nodes"]]), 0.0) << line;
             EXPECT_GT(num(f[at["train_seconds"]]), 0.0) << line;
             EXPECT_GT(num(f[at["compression"]]), 1.0) << line; // 384k triangles vs a 2^12 grid
+            const double capped = num(f[at["leaf_cap_fraction"]]); // rays truncated by the leaf budget
+            EXPECT_TRUE(std::isfinite(capped) && capped >= 0.0 && capped <= 1.0) << line;
             if ((variant == "lod" && f[at["lod"]] == "0") || variant == "switch") {
                 EXPECT_GE(num(f[at["equal_time_spp"]]), 1.0) << line;
                 EXPECT_TRUE(std::isfinite(num(f[at["equal_time_flip"]]))) << line;
