@@ -68,6 +68,34 @@ SceneFeatures derive_features(const Scene& scene, const Environment& environment
     return f;
 }
 
+SceneFeatures sampled_features(SceneFeatures f, const GpuSceneData& d) {
+    f.emission = f.emission && d.emissive_light_count > 0;
+    f.punctual = f.punctual && d.punctual_light_count > 0;
+    f.environment = f.environment && d.environment.inv_mean > 0.0f && d.environment.intensity > 0.0f;
+    return f;
+}
+
+const std::vector<ForcibleFeature>& forcible_features() {
+    static const std::vector<ForcibleFeature> list = {
+        {"textures", &SceneFeatures::textures},         {"normal_maps", &SceneFeatures::normal_maps},
+        {"emission", &SceneFeatures::emission},         {"environment", &SceneFeatures::environment},
+        {"alpha_mask", &SceneFeatures::alpha_mask},     {"transmission", &SceneFeatures::transmission},
+        {"punctual", &SceneFeatures::punctual},         {"single_sided", &SceneFeatures::single_sided}};
+    return list;
+}
+
+SceneFeatures all_forcible_features() {
+    SceneFeatures f;
+    for (const ForcibleFeature& x : forcible_features()) f.*x.flag = true;
+    return f;
+}
+
+SceneFeatures with_forced(SceneFeatures derived, const SceneFeatures& forced) {
+    if (forced.neural) throw Error("the neural feature cannot be forced: a hybrid render needs a model");
+    for (const ForcibleFeature& x : forcible_features()) derived.*x.flag = derived.*x.flag || forced.*x.flag;
+    return derived;
+}
+
 std::vector<vk::SpecConstant> specialization(const SceneFeatures& f) {
     return {{NB_SC_TEXTURES, f.textures ? 1u : 0u},       {NB_SC_NORMAL_MAPS, f.normal_maps ? 1u : 0u},
             {NB_SC_EMISSION, f.emission ? 1u : 0u},       {NB_SC_ENVIRONMENT, f.environment ? 1u : 0u},

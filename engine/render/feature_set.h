@@ -29,12 +29,34 @@ struct SceneFeatures {
     bool operator==(const SceneFeatures&) const = default;
 };
 
+// The features a render can be forced to simulate although the scene lacks them (RenderOptions::
+// forced_features; tests/render/bench_features.cpp measures what each specialization saves): every
+// flag but `neural`. Forcing one never changes the image, only the work: the shaders test per material,
+// texture and light whether an effect applies (a texture index >= 0, an alpha mode, double_sided, a
+// transmission weight, light counts, an environment of positive mean), so a forced flag adds those
+// tests, the UV interpolation, the next-event strategy and the shadow pass, and nothing more.
+struct ForcibleFeature {
+    const char* name;             // "textures", "normal_maps", ... (the SceneFeatures member's name)
+    bool SceneFeatures::*flag;
+};
+const std::vector<ForcibleFeature>& forcible_features();
+SceneFeatures all_forcible_features(); // every flag of forcible_features() set
+// `derived` with every flag of `forced` turned on as well; throws nbvh::Error when `forced` asks for
+// `neural` (a hybrid render needs a model, not a flag).
+SceneFeatures with_forced(SceneFeatures derived, const SceneFeatures& forced);
+
 // Derives the features from the scene, the environment the render will use (`environment` may differ
 // from scene.environment: --env, the default sky, or none with --env none) and the neural options (neural: a model is given,
 // not --classical, and some instance is neural). Emission counts only materials that are referenced by a
 // triangle of an instanced mesh.
 SceneFeatures derive_features(const Scene& scene, const Environment& environment,
                               const NeuralRenderOptions& neural = {});
+
+// The features of a packed scene that next-event estimation can really sample (WavefrontRenderer applies
+// it to derive_features()): emission only with an emissive triangle of positive area outside outline
+// shells (GpuSceneData::emissive_light_count), punctual lights only with positive power, the environment
+// only with a positive mean (a map of black texels lights nothing). The shadow pass runs iff has_lights().
+SceneFeatures sampled_features(SceneFeatures derived, const GpuSceneData& data);
 
 // What the neural stage of a hybrid render runs (engine/render/NEURAL.md), read from a NeuralStage.
 struct NeuralPlan {

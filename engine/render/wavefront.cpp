@@ -94,7 +94,8 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     std::vector<GpuInstance> classical_instances = data_.instances;
     if (nopt.model) features_.neural = mark_neural_instances(scene, accel, *nopt.model, data_) > 0;
     hybrid_ = features_.neural && !nopt.classical;
-    if (features_.emission && data_.emissive_light_count == 0) features_.emission = false;
+    features_ = sampled_features(features_, data_); // the lights as packed: no shadow pass without one
+    features_ = with_forced(features_, options_.forced_features);
 
     // Per-render parameters.
     GpuFrameParams& p = params_;
@@ -194,7 +195,8 @@ bool WavefrontRenderer::apply(const RenderOptions& o) {
     const bool overrides = n.roughness >= 0.0f || n.metallic >= 0.0f;
     if (o.width != c.width || o.height != c.height || o.max_wave_pixels != c.max_wave_pixels || n.model != cn.model ||
         n.path != cn.path || (n.model && effective_leaves_per_round(n) != neural_->leaves_per_round()) ||
-        (n.classical && overrides) != classical_overrides_ || (n.model && !features_.neural && !n.classical))
+        (n.classical && overrides) != classical_overrides_ || (n.model && !features_.neural && !n.classical) ||
+        !(o.forced_features == c.forced_features))
         return false;
     if (n.model) validate(n, *scene_);
     ++live_updates_;

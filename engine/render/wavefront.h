@@ -35,6 +35,9 @@ struct RenderOptions {
     // the 1080p classical frame ~1.5x slower than one (results/neural/README.md, v12 vs v13).
     uint32_t max_wave_pixels = 1u << 22;
     NeuralRenderOptions neural;      // hybrid (model) or classical-reference render of neural instances
+    // Effects simulated although the scene lacks them (feature_set.h with_forced: same image, more
+    // work); benchmarks only. The texture path is still chosen from the scene's own features.
+    SceneFeatures forced_features;
 };
 
 struct RenderStats {

@@ -26,9 +26,11 @@ uint nb_light_search(uint base, uint n, float u) {
 }
 
 // Probabilities of the three next-event strategies: environment, emissive triangles, punctual lights,
-// equal among those the scene has (they sum to 1, or are all 0 without any light).
+// equal among those the scene has (they sum to 1, or are all 0 without any light). An environment of
+// zero mean (none, or a black map: env_inv_mean 0) is no strategy, as a light count of 0 is none: a
+// feature forced on where the scene lacks it (feature_set.h with_forced) leaves the image unchanged.
 void nb_light_strategies(out float p_env, out float p_emissive, out float p_punctual) {
-    float env = NB_HAS_ENVIRONMENT ? 1.0f : 0.0f;
+    float env = (NB_HAS_ENVIRONMENT && params.env_inv_mean > 0.0f && params.env_intensity > 0.0f) ? 1.0f : 0.0f;
     float emissive = (NB_HAS_EMISSION && params.light_count > 0u) ? 1.0f : 0.0f;
     float punctual = (NB_HAS_PUNCTUAL && params.punctual_count > 0u) ? 1.0f : 0.0f;
     float n = env + emissive + punctual;
