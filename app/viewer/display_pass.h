@@ -1,6 +1,6 @@
 // The viewer's display pass: the renderer's linear output pixels -> packed RGBA8 display bytes on the
 // GPU (passes/display.comp, shared/display.h: the same bytes as `nbvh render`'s PNGs), recorded into
-// the presenter's command buffer. Before it, each frame downloaded the float film (16 bytes a pixel),
+// a frame slot's command buffer (film_stage.h). Before it, each frame downloaded the float film (16 bytes a pixel),
 // tone-mapped it on one CPU core and uploaded the bytes again.
 #pragma once
 #include <cstdint>
@@ -9,6 +9,7 @@
 
 #include "engine/core/image.h"
 #include "engine/vk/buffer.h"
+#include "engine/vk/commands.h"
 #include "engine/vk/context.h"
 #include "engine/vk/pipeline.h"
 
@@ -21,7 +22,7 @@ public:
     // Records the conversion of `pixels` linear RGBA32F pixels of `linear` into `packed` (one uint32 a
     // pixel, R in the low byte, alpha 255), then a barrier that makes `packed` ready for a transfer read.
     // Binds the buffers on first use and when they change; do not call while a previous recording runs.
-    void record(VkCommandBuffer cmd, const vk::Buffer& linear, const vk::Buffer& packed, uint32_t pixels,
+    void record(vk::CommandBuffer& cmd, const vk::Buffer& linear, const vk::Buffer& packed, uint32_t pixels,
                 float exposure, ToneMap tone_map);
 
 private:

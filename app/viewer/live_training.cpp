@@ -1,6 +1,7 @@
 #include "app/viewer/live_training.h"
 
 #include <algorithm>
+#include <limits>
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
@@ -30,9 +31,18 @@ public:
     StepStats step(const StepParams& params) override {
         owner_.checkpoint();
         StepStats st = inner_.step(params);
-        if (!st.skipped && (params.step + 1) % every_ == 0 && params.step + 1 < options_.steps && !params.cuts.empty())
-            owner_.publish(snapshot(*params.cuts[0], params.step + 1));
+        // The trainer's per-node sums (statistics of the leaves of cuts[0], steps that trained only).
+        if (!st.skipped && !params.cuts.empty() && st.leaves.size() == params.cuts[0]->leaves.size())
+            for (size_t i = 0; i < st.leaves.size(); ++i)
+                sums_.add(params.cuts[0]->leaves[i], st.leaves[i].loss_sum, st.leaves[i].samples);
+        if (!st.skipped && (params.step + 1) % every_ == 0 && params.step + 1 < options_.steps && !params.cuts.empty()) {
+            auto model = snapshot(*params.cuts[0], params.step + 1);
+            owner_.publish(model, node_loss(*model));
+        }
         return st;
+    }
+    std::shared_ptr<const std::vector<float>> node_loss(const NeuralModel& model) const {
+        return std::make_shared<const std::vector<float>>(sums_.per_node(model));
     }
 
 private:
@@ -65,6 +75,7 @@ private:
     TrainOptions options_;
     std::string source_;
     uint32_t every_;
+    NodeLossSums sums_;
 };
 
 BackendChoice parse_backend(const std::string& s) {
@@ -74,6 +85,24 @@ BackendChoice parse_backend(const std::string& s) {
 }
 
 } // namespace
+
+void NodeLossSums::add(uint32_t base_node, double loss, uint64_t n) {
+    if (base_node >= loss_sum.size()) {
+        loss_sum.resize(size_t(base_node) + 1, 0.0);
+        samples.resize(size_t(base_node) + 1, 0);
+    }
+    loss_sum[base_node] += loss;
+    samples[base_node] += n;
+}
+
+std::vector<float> NodeLossSums::per_node(const NeuralModel& model) const {
+    std::vector<float> out(model.nodes.size(), std::numeric_limits<float>::quiet_NaN());
+    for (size_t n = 0; n < model.nodes.size(); ++n) {
+        const uint32_t b = model.nodes[n].base_node;
+        if (b < samples.size() && samples[b] > 0) out[n] = float(loss_sum[b] / double(samples[b]));
+    }
+    return out;
+}
 
 LiveTrainer::~LiveTrainer() { stop(); }
 
@@ -101,6 +130,7 @@ void LiveTrainer::start(const Scene& scene, const std::string& source, const Tra
         status_.backend = backend == BackendChoice::cuda ? "cuda" : "cpu";
         paused_ = stop_ = false;
         latest_.reset();
+        latest_loss_.reset();
         taken_ = true;
         history_stride_ = 1;
     }
@@ -119,7 +149,8 @@ void LiveTrainer::start(const Scene& scene, const std::string& source, const Tra
             const TrainResult result = train_asset(asset, opt, be, [this](const TrainProgress& p) {
                 record(p.step, p.steps, p.nodes, p.loss, p.eta_s);
             });
-            publish(std::make_shared<NeuralModel>(make_neural_model(asset, result, opt, source, 0)));
+            auto model = std::make_shared<NeuralModel>(make_neural_model(asset, result, opt, source, 0));
+            publish(model, be.node_loss(*model));
             log_info("view: training done: %u nodes, final loss %.4f, %.1f s", result.tree.node_count(),
                      result.log.empty() ? 0.0 : result.log.back().loss.total, result.seconds);
         } catch (const TrainingStopped&) {
@@ -162,10 +193,11 @@ TrainStatus LiveTrainer::status() const {
     return status_;
 }
 
-std::shared_ptr<const NeuralModel> LiveTrainer::take_model() {
+std::shared_ptr<const NeuralModel> LiveTrainer::take_model(std::shared_ptr<const std::vector<float>>* node_loss) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (taken_) return nullptr;
     taken_ = true;
+    if (node_loss) *node_loss = latest_loss_;
     return latest_;
 }
 
@@ -180,9 +212,11 @@ void LiveTrainer::checkpoint() {
     if (stop_) throw TrainingStopped{};
 }
 
-void LiveTrainer::publish(std::shared_ptr<const NeuralModel> model) {
+void LiveTrainer::publish(std::shared_ptr<const NeuralModel> model,
+                          std::shared_ptr<const std::vector<float>> node_loss) {
     std::lock_guard<std::mutex> lock(mutex_);
     latest_ = std::move(model);
+    latest_loss_ = std::move(node_loss);
     taken_ = false;
     status_.snapshots++;
 }

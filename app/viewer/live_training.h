@@ -7,7 +7,10 @@
 // Snapshots come from a backend wrapper (SnapshotBackend in the .cpp) that sees each step's cut and
 // reads the backend's weights, so trainer/ needs no hook: the snapshot's N-BVH is rebuilt from the cut's
 // base-BVH leaves (one LoD), the weights are the backend's fp32 masters converted to fp16 as the model
-// file stores them.
+// file stores them. The wrapper also sums each cut leaf's training loss from the step statistics, as
+// the trainer does for its split heuristic (trainer.cpp NodeStats: q = loss_sum / samples over the
+// steps that trained, from the node's creation), so every published model comes with the mean loss of
+// each of its N-BVH nodes (the loss view, loss_view.h; paper Fig. 4).
 #pragma once
 #include <atomic>
 #include <condition_variable>
@@ -23,6 +26,15 @@
 #include "engine/scene/scene.h"
 
 namespace nbvh::viewer {
+
+// Mean training loss per sample of every node of `model` (index = model node), from sums per base-BVH
+// node (NbvhNode::base_node); NaN for nodes that never trained a sample (or have no base node).
+struct NodeLossSums {
+    std::vector<double> loss_sum;   // per base-BVH node
+    std::vector<uint64_t> samples;
+    void add(uint32_t base_node, double loss, uint64_t n);
+    std::vector<float> per_node(const NeuralModel& model) const;
+};
 
 struct TrainStatus {
     std::string state;                // "" (never started), running, paused, done, stopped, failed: MSG
@@ -47,14 +59,15 @@ public:
     void stop();          // asks the worker to stop after its current step and waits for it
     bool active() const;  // the worker runs (training or paused)
     TrainStatus status() const;
-    // The newest model not taken yet (a snapshot, or the final model), else null.
-    std::shared_ptr<const NeuralModel> take_model();
+    // The newest model not taken yet (a snapshot, or the final model), else null; with `node_loss`, that
+    // model's per-node training loss (NodeLoss).
+    std::shared_ptr<const NeuralModel> take_model(std::shared_ptr<const std::vector<float>>* node_loss = nullptr);
     // The newest model (for saving), else null.
     std::shared_ptr<const NeuralModel> latest_model() const;
 
     // Called by the worker (SnapshotBackend): blocks while paused, throws when stopped.
     void checkpoint();
-    void publish(std::shared_ptr<const NeuralModel> model);
+    void publish(std::shared_ptr<const NeuralModel> model, std::shared_ptr<const std::vector<float>> node_loss);
     void record(uint32_t step, uint32_t steps, uint32_t nodes, double loss, double eta_s);
 
 private:
@@ -67,6 +80,7 @@ private:
     bool paused_ = false, stop_ = false;
     TrainStatus status_;
     std::shared_ptr<const NeuralModel> latest_;
+    std::shared_ptr<const std::vector<float>> latest_loss_;
     bool taken_ = true;
     uint32_t history_stride_ = 1;
 };

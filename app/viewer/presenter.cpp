@@ -17,20 +17,6 @@ namespace {
 bool is_srgb(VkFormat f) { return f == VK_FORMAT_B8G8R8A8_SRGB || f == VK_FORMAT_R8G8B8A8_SRGB; }
 bool is_bgra(VkFormat f) { return f == VK_FORMAT_B8G8R8A8_SRGB || f == VK_FORMAT_B8G8R8A8_UNORM; }
 
-void image_barrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to,
-                   VkPipelineStageFlags src_stage, VkAccessFlags src_access, VkPipelineStageFlags dst_stage,
-                   VkAccessFlags dst_access) {
-    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-    b.oldLayout = from;
-    b.newLayout = to;
-    b.srcAccessMask = src_access;
-    b.dstAccessMask = dst_access;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 0, nullptr, 0, nullptr, 1, &b);
-}
-
 void glfw_error(int code, const char* text) { log_debug("glfw error %d: %s", code, text); }
 
 } // namespace
@@ -96,7 +82,7 @@ void Window::framebuffer_size(uint32_t* width, uint32_t* height) const {
 // --- Presenter ----------------------------------------------------------------------------------
 
 Presenter::Presenter(const vk::Context& ctx, const Window& window)
-    : ctx_(ctx), window_(window), display_(ctx), display_right_(ctx) {
+    : ctx_(ctx), window_(window) {
     NBVH_VK_CHECK(glfwCreateWindowSurface(ctx_.instance(), window_.handle(), nullptr, &surface_));
     VkBool32 supported = VK_FALSE;
     NBVH_VK_CHECK(vkGetPhysicalDeviceSurfaceSupportKHR(ctx_.physical_device(), ctx_.queue_family(), surface_, &supported));
@@ -155,29 +141,17 @@ Presenter::Presenter(const vk::Context& ctx, const Window& window)
     rp.pDependencies = &dep;
     NBVH_VK_CHECK(vkCreateRenderPass(ctx_.device(), &rp, nullptr, &render_pass_));
 
-    VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-    pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-    pool.queueFamilyIndex = ctx_.queue_family();
-    NBVH_VK_CHECK(vkCreateCommandPool(ctx_.device(), &pool, nullptr, &pool_));
-    VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    alloc.commandPool = pool_;
-    alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    alloc.commandBufferCount = 1;
-    NBVH_VK_CHECK(vkAllocateCommandBuffers(ctx_.device(), &alloc, &cmd_));
-    VkSemaphoreCreateInfo si{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-    NBVH_VK_CHECK(vkCreateSemaphore(ctx_.device(), &si, nullptr, &acquired_));
-    VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    NBVH_VK_CHECK(vkCreateFence(ctx_.device(), &fi, nullptr, &fence_));
+    // Frame slots: an sRGB swapchain gets sRGB film images (a blit between sRGB formats decodes and
+    // re-encodes, identity up to rounding), a UNORM one UNORM images (the bytes are copied).
+    for (uint32_t i = 0; i < FRAMES_IN_FLIGHT; ++i)
+        frames_.push_back(std::make_unique<FrameSlot>(ctx_, is_srgb(format_.format), "viewer frame"));
     create_swapchain();
 }
 
 Presenter::~Presenter() {
     vkDeviceWaitIdle(ctx_.device());
+    frames_.clear();
     destroy_swapchain();
-    destroy_film_image();
-    if (fence_) vkDestroyFence(ctx_.device(), fence_, nullptr);
-    if (acquired_) vkDestroySemaphore(ctx_.device(), acquired_, nullptr);
-    if (pool_) vkDestroyCommandPool(ctx_.device(), pool_, nullptr);
     if (render_pass_) vkDestroyRenderPass(ctx_.device(), render_pass_, nullptr);
     if (surface_) vkDestroySurfaceKHR(ctx_.instance(), surface_, nullptr);
 }
@@ -239,10 +213,7 @@ void Presenter::create_swapchain() {
         VkFramebuffer framebuffer = VK_NULL_HANDLE;
         NBVH_VK_CHECK(vkCreateFramebuffer(ctx_.device(), &fb, nullptr, &framebuffer));
         framebuffers_.push_back(framebuffer);
-        VkSemaphoreCreateInfo si{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-        VkSemaphore sem = VK_NULL_HANDLE;
-        NBVH_VK_CHECK(vkCreateSemaphore(ctx_.device(), &si, nullptr, &sem));
-        render_done_.push_back(sem);
+        render_done_.emplace_back(ctx_, "viewer render done");
     }
     if (can_read_back_)
         readback_ = vk::Buffer(ctx_, uint64_t(extent_.width) * extent_.height * 4, vk::MemoryKind::host, 0,
@@ -252,7 +223,6 @@ void Presenter::create_swapchain() {
 void Presenter::destroy_swapchain() {
     for (VkFramebuffer f : framebuffers_) vkDestroyFramebuffer(ctx_.device(), f, nullptr);
     for (VkImageView v : views_) vkDestroyImageView(ctx_.device(), v, nullptr);
-    for (VkSemaphore s : render_done_) vkDestroySemaphore(ctx_.device(), s, nullptr);
     framebuffers_.clear();
     views_.clear();
     render_done_.clear();
@@ -262,123 +232,46 @@ void Presenter::destroy_swapchain() {
     readback_ = vk::Buffer();
 }
 
-void Presenter::ensure_film_image(uint32_t width, uint32_t height) {
-    if (film_image_ && film_width_ == width && film_height_ == height) return;
-    destroy_film_image();
-    // Same sRGB-ness as the swapchain: a blit between UNORM formats copies the encoded bytes, one
-    // between sRGB formats decodes and re-encodes them (identity up to rounding).
-    VkImageCreateInfo ii{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-    ii.imageType = VK_IMAGE_TYPE_2D;
-    ii.format = is_srgb(format_.format) ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
-    ii.extent = {width, height, 1};
-    ii.mipLevels = 1;
-    ii.arrayLayers = 1;
-    ii.samples = VK_SAMPLE_COUNT_1_BIT;
-    ii.tiling = VK_IMAGE_TILING_OPTIMAL;
-    ii.usage = VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-    ii.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    NBVH_VK_CHECK(vkCreateImage(ctx_.device(), &ii, nullptr, &film_image_));
-    VkMemoryRequirements req{};
-    vkGetImageMemoryRequirements(ctx_.device(), film_image_, &req);
-    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    ai.allocationSize = req.size;
-    ai.memoryTypeIndex = ctx_.find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    NBVH_VK_CHECK(vkAllocateMemory(ctx_.device(), &ai, nullptr, &film_memory_));
-    NBVH_VK_CHECK(vkBindImageMemory(ctx_.device(), film_image_, film_memory_, 0));
-    packed_ = vk::Buffer(ctx_, uint64_t(width) * height * 4, vk::MemoryKind::device, 0, "viewer film bytes");
-    packed_right_ = vk::Buffer();
-    upload_ = vk::Buffer();
-    film_width_ = width;
-    film_height_ = height;
-}
-
-void Presenter::destroy_film_image() {
-    if (film_image_) vkDestroyImage(ctx_.device(), film_image_, nullptr);
-    if (film_memory_) vkFreeMemory(ctx_.device(), film_memory_, nullptr);
-    film_image_ = VK_NULL_HANDLE;
-    film_memory_ = VK_NULL_HANDLE;
-    packed_ = vk::Buffer();
-    packed_right_ = vk::Buffer();
-    upload_ = vk::Buffer();
+void Presenter::recreate_swapchain() {
+    vkDeviceWaitIdle(ctx_.device()); // every frame in flight is done with the old images
+    destroy_swapchain();
+    create_swapchain();
 }
 
 bool Presenter::draw(const FilmSource& film, const std::function<void(VkCommandBuffer)>& ui, Screenshot* shot) {
-    NBVH_CHECK(film.linear && film.width > 0 && film.height > 0 &&
-               film.linear->size() >= uint64_t(film.width) * film.height * 16u);
-    const uint32_t width = film.width, height = film.height;
     uint32_t fw = 0, fh = 0;
     window_.framebuffer_size(&fw, &fh);
     if (fw == 0 || fh == 0) return false;
     if (!swapchain_ || fw != extent_.width || fh != extent_.height) {
-        vkDeviceWaitIdle(ctx_.device());
-        destroy_swapchain();
-        create_swapchain();
+        recreate_swapchain();
         if (!swapchain_) return false;
     }
+    // The slot's previous frame must be done before its semaphore, buffers and image are reused.
+    FrameSlot& f = *frames_[frame_ % FRAMES_IN_FLIGHT];
+    f.cmd.wait();
     uint32_t index = 0;
-    VkResult r = vkAcquireNextImageKHR(ctx_.device(), swapchain_, UINT64_MAX, acquired_, VK_NULL_HANDLE, &index);
-    if (r == VK_ERROR_OUT_OF_DATE_KHR) {
-        vkDeviceWaitIdle(ctx_.device());
-        destroy_swapchain();
-        create_swapchain();
+    VkResult r = vkAcquireNextImageKHR(ctx_.device(), swapchain_, UINT64_MAX, f.acquired.handle(), VK_NULL_HANDLE,
+                                       &index);
+    if (r == VK_ERROR_OUT_OF_DATE_KHR) { // the semaphore was not signalled
+        recreate_swapchain();
         return false;
     }
     if (r != VK_SUBOPTIMAL_KHR) NBVH_VK_CHECK(r);
 
-    ensure_film_image(width, height);
-
-    NBVH_VK_CHECK(vkResetCommandBuffer(cmd_, 0));
-    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    NBVH_VK_CHECK(vkBeginCommandBuffer(cmd_, &bi));
-    const VkPipelineStageFlags T = VK_PIPELINE_STAGE_TRANSFER_BIT;
-    // Linear film -> display bytes (compute) -> film image; or the host's bytes -> film image.
-    const uint32_t split = film.linear_right ? std::min(film.split_column, width) : width;
-    VkBuffer left = packed_.handle();
-    if (film.rgba8) {
-        NBVH_CHECK(film.rgba8->size() == size_t(width) * height);
-        if (!upload_)
-            upload_ = vk::Buffer(ctx_, uint64_t(width) * height * 4, vk::MemoryKind::host, 0, "viewer host bytes");
-        std::memcpy(upload_.mapped(), film.rgba8->data(), film.rgba8->size() * 4);
-        left = upload_.handle();
-    } else {
-        display_.record(cmd_, *film.linear, packed_, width * height, film.exposure, film.tone_map);
-        if (split < width) {
-            if (!packed_right_)
-                packed_right_ = vk::Buffer(ctx_, uint64_t(width) * height * 4, vk::MemoryKind::device, 0,
-                                           "viewer right film bytes");
-            display_right_.record(cmd_, *film.linear_right, packed_right_, width * height, film.exposure,
-                                  film.tone_map);
-        }
-    }
-    image_barrier(cmd_, film_image_, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, T, 0, T,
-                  VK_ACCESS_TRANSFER_WRITE_BIT);
-    // Columns [0, split) from the left bytes, [split, width) from the right film's (same row pitch).
-    VkBufferImageCopy copy{};
-    copy.bufferRowLength = width;
-    copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    if (film.rgba8 || split > 0) {
-        copy.imageExtent = {film.rgba8 ? width : split, height, 1};
-        vkCmdCopyBufferToImage(cmd_, left, film_image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
-    }
-    if (!film.rgba8 && split < width) {
-        copy.bufferOffset = uint64_t(split) * 4;
-        copy.imageOffset = {int32_t(split), 0, 0};
-        copy.imageExtent = {width - split, height, 1};
-        vkCmdCopyBufferToImage(cmd_, packed_right_.handle(), film_image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
-                               &copy);
-    }
-    image_barrier(cmd_, film_image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, T,
-                  VK_ACCESS_TRANSFER_WRITE_BIT, T, VK_ACCESS_TRANSFER_READ_BIT);
+    vk::CommandBuffer& cmd = f.cmd;
+    cmd.begin();
+    const vk::Image& image = f.film.record(cmd, film);
+    const uint32_t width = image.width(), height = image.height();
     // Swapchain image: clear (letterbox bars), then the film scaled to fit with its aspect kept.
-    VkImage target = images_[index];
-    image_barrier(cmd_, target, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, T, 0, T,
-                  VK_ACCESS_TRANSFER_WRITE_BIT);
+    const VkPipelineStageFlags T = VK_PIPELINE_STAGE_TRANSFER_BIT;
+    const VkImage target = images_[index];
+    cmd.transition(target, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, T, 0, T,
+                   VK_ACCESS_TRANSFER_WRITE_BIT);
     const VkClearColorValue black{{0.0f, 0.0f, 0.0f, 1.0f}};
     const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    vkCmdClearColorImage(cmd_, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &black, 1, &range);
-    image_barrier(cmd_, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, T,
-                  VK_ACCESS_TRANSFER_WRITE_BIT, T, VK_ACCESS_TRANSFER_WRITE_BIT);
+    vkCmdClearColorImage(cmd.handle(), target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &black, 1, &range);
+    cmd.transition(target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, T,
+                   VK_ACCESS_TRANSFER_WRITE_BIT, T, VK_ACCESS_TRANSFER_WRITE_BIT);
     const float scale = std::min(float(extent_.width) / float(width), float(extent_.height) / float(height));
     const int32_t dw = std::max(1, int32_t(float(width) * scale + 0.5f));
     const int32_t dh = std::max(1, int32_t(float(height) * scale + 0.5f));
@@ -391,58 +284,51 @@ bool Presenter::draw(const FilmSource& film, const std::function<void(VkCommandB
     blit.dstOffsets[1] = {std::max(dx, 0) + std::min(dw, int32_t(extent_.width)),
                           std::max(dy, 0) + std::min(dh, int32_t(extent_.height)), 1};
     const VkFilter filter = (dw == int32_t(width) && dh == int32_t(height)) ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
-    vkCmdBlitImage(cmd_, film_image_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target,
+    cmd.transition(image.handle(), VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, T,
+                   VK_ACCESS_TRANSFER_WRITE_BIT, T, VK_ACCESS_TRANSFER_READ_BIT);
+    vkCmdBlitImage(cmd.handle(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target,
                    VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, filter);
-    image_barrier(cmd_, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, T,
-                  VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-                  VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
+    cmd.transition(image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL, T,
+                   VK_ACCESS_TRANSFER_READ_BIT, T, 0); // the image layer's convention (engine/vk/image.h)
+    cmd.transition(target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, T,
+                   VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                   VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
     // UI on top.
     VkRenderPassBeginInfo rb{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
     rb.renderPass = render_pass_;
     rb.framebuffer = framebuffers_[index];
     rb.renderArea.extent = extent_;
-    vkCmdBeginRenderPass(cmd_, &rb, VK_SUBPASS_CONTENTS_INLINE);
-    if (ui) ui(cmd_);
-    vkCmdEndRenderPass(cmd_);
+    vkCmdBeginRenderPass(cmd.handle(), &rb, VK_SUBPASS_CONTENTS_INLINE);
+    if (ui) ui(cmd.handle());
+    vkCmdEndRenderPass(cmd.handle());
     const bool read = shot && can_read_back_;
     if (read) {
-        image_barrier(cmd_, target, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                      VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, T,
-                      VK_ACCESS_TRANSFER_READ_BIT);
+        cmd.transition(target, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                       VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, T,
+                       VK_ACCESS_TRANSFER_READ_BIT);
         VkBufferImageCopy back{};
         back.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
         back.imageExtent = {extent_.width, extent_.height, 1};
-        vkCmdCopyImageToBuffer(cmd_, target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.handle(), 1, &back);
-        image_barrier(cmd_, target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, T,
-                      VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, 0);
-        VkMemoryBarrier host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-        host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-        vkCmdPipelineBarrier(cmd_, T, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &host, 0, nullptr, 0, nullptr);
+        vkCmdCopyImageToBuffer(cmd.handle(), target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.handle(), 1,
+                               &back);
+        cmd.transition(target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, T,
+                       VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, 0);
+        cmd.barrier(vk::Barrier::compute_to_host);
     }
-    NBVH_VK_CHECK(vkEndCommandBuffer(cmd_));
-
-    const VkPipelineStageFlags wait_stage = T | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
-    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    si.waitSemaphoreCount = 1;
-    si.pWaitSemaphores = &acquired_;
-    si.pWaitDstStageMask = &wait_stage;
-    si.commandBufferCount = 1;
-    si.pCommandBuffers = &cmd_;
-    si.signalSemaphoreCount = 1;
-    si.pSignalSemaphores = &render_done_[index];
-    NBVH_VK_CHECK(vkResetFences(ctx_.device(), 1, &fence_));
-    NBVH_VK_CHECK(vkQueueSubmit(ctx_.queue(), 1, &si, fence_));
+    const VkSemaphore done = render_done_[index].handle();
+    cmd.submit({.wait = f.acquired.handle(), .wait_stage = T | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                .signal = done});
+    ++frame_;
 
     VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
     pi.waitSemaphoreCount = 1;
-    pi.pWaitSemaphores = &render_done_[index];
+    pi.pWaitSemaphores = &done;
     pi.swapchainCount = 1;
     pi.pSwapchains = &swapchain_;
     pi.pImageIndices = &index;
     r = vkQueuePresentKHR(ctx_.queue(), &pi);
-    NBVH_VK_CHECK(vkWaitForFences(ctx_.device(), 1, &fence_, VK_TRUE, UINT64_MAX));
     if (read) {
+        cmd.wait();
         shot->width = extent_.width;
         shot->height = extent_.height;
         shot->rgb.resize(size_t(extent_.width) * extent_.height * 3);
@@ -454,13 +340,8 @@ bool Presenter::draw(const FilmSource& film, const std::function<void(VkCommandB
             shot->rgb[3 * i + 2] = src[4 * i + (bgra ? 0 : 2)];
         }
     }
-    if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR) {
-        vkDeviceWaitIdle(ctx_.device());
-        destroy_swapchain();
-        create_swapchain();
-    } else {
-        NBVH_VK_CHECK(r);
-    }
+    if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR) recreate_swapchain();
+    else NBVH_VK_CHECK(r);
     return true;
 }
 

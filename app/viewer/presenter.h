@@ -1,22 +1,25 @@
 // The viewer's window and swapchain: a GLFW window without a client API, its Vulkan surface, a
 // swapchain, and the per-frame commands that put the film on screen:
-//   renderer output (linear RGBA32F, on the GPU) -> display pass (tone map + sRGB -> RGBA8 bytes, as
-//   `nbvh render`'s PNGs; display_pass.h) -> film image
-//   -> clear + aspect-preserving blit into the swapchain image -> render pass (UI drawn on top,
-//   loadOp LOAD) -> [copy to a readback buffer for --screenshot] -> present.
-// One frame in flight: the path tracer waits for its own submissions anyway, so more would buy
-// nothing but complexity. Presentation needs the Context's queue family to support the surface.
+//   film stage (film_stage.h: display pass -> RGBA8 film image) -> clear + aspect-preserving blit into
+//   the swapchain image -> render pass (UI drawn on top, loadOp LOAD) -> [copy to a readback buffer for
+//   --screenshot] -> present.
+// FRAMES_IN_FLIGHT frames in flight: draw() submits and presents without waiting; it waits only for the
+// frame that last used the same slot (and for a screenshot's own frame). Recording, submission, the film
+// image and semaphores are engine/vk objects (FrameSlot); what engine/vk has no notion of (surface,
+// swapchain, its image views and framebuffers, the UI render pass) stays here. Presentation needs the
+// Context's queue family to support the surface.
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <vulkan/vulkan.h>
 
-#include "app/viewer/display_pass.h"
-#include "engine/core/image.h"
+#include "app/viewer/film_stage.h"
 #include "engine/vk/buffer.h"
+#include "engine/vk/commands.h"
 #include "engine/vk/context.h"
 
 struct GLFWwindow;
@@ -54,18 +57,6 @@ struct Screenshot {
     std::vector<uint8_t> rgb;
 };
 
-// What a frame shows: the renderer's linear output on the GPU (WavefrontRenderer::output()); in the
-// split view a second film right of a column; in the difference and FLIP views bytes made on the host.
-struct FilmSource {
-    const vk::Buffer* linear = nullptr; // width*height RGBA32F pixels, rows top to bottom
-    uint32_t width = 0, height = 0;
-    float exposure = 0.0f;              // stops
-    ToneMap tone_map = ToneMap::aces;   // as nbvh render's PNGs
-    const vk::Buffer* linear_right = nullptr; // split view: columns >= split_column come from this film
-    uint32_t split_column = 0;
-    const std::vector<uint32_t>* rgba8 = nullptr; // shown instead of the films (display-pass packing)
-};
-
 class Presenter {
 public:
     Presenter(const vk::Context& ctx, const Window& window);
@@ -79,17 +70,17 @@ public:
     VkFormat format() const { return format_.format; }
     bool can_read_back() const { return can_read_back_; }
 
-    // Draws one frame: the film (display pass on the GPU, then scaled to the window), `ui` records draw
-    // commands inside the render pass. Fills `shot` (when not null and can_read_back()) with the window
-    // content. Returns false when nothing was presented (minimised window, or the swapchain was out of
-    // date and has been recreated).
+    // Draws one frame: the film (film stage on the GPU, then scaled to the window), `ui` records draw
+    // commands inside the render pass. Submits and presents without waiting for the GPU (it waits for
+    // the frame FRAMES_IN_FLIGHT back). Fills `shot` (when not null and can_read_back()) with the window
+    // content, waiting for this frame. Returns false when nothing was presented (minimised window, or
+    // the swapchain was out of date and has been recreated).
     bool draw(const FilmSource& film, const std::function<void(VkCommandBuffer)>& ui, Screenshot* shot = nullptr);
 
 private:
     void create_swapchain();
     void destroy_swapchain();
-    void ensure_film_image(uint32_t width, uint32_t height);
-    void destroy_film_image();
+    void recreate_swapchain();
 
     const vk::Context& ctx_;
     const Window& window_;
@@ -100,25 +91,14 @@ private:
     VkExtent2D extent_{};
     uint32_t min_image_count_ = 2;
     bool can_read_back_ = false;
-    std::vector<VkImage> images_;
+    std::vector<VkImage> images_;           // owned by the swapchain
     std::vector<VkImageView> views_;
     std::vector<VkFramebuffer> framebuffers_;
-    std::vector<VkSemaphore> render_done_; // one per swapchain image (presentation holds it)
+    std::vector<vk::Semaphore> render_done_; // one per swapchain image (presentation holds it)
+    vk::Buffer readback_;                    // host-visible swapchain copy (screenshots)
 
-    VkImage film_image_ = VK_NULL_HANDLE;
-    VkDeviceMemory film_memory_ = VK_NULL_HANDLE;
-    uint32_t film_width_ = 0, film_height_ = 0;
-    vk::Buffer packed_;   // RGBA8 film bytes, written by the display pass
-    DisplayPass display_;
-    vk::Buffer packed_right_; // the split view's right film, by its own pass (one descriptor set each)
-    DisplayPass display_right_;
-    vk::Buffer upload_;   // host bytes (difference / FLIP views)
-    vk::Buffer readback_; // host-visible swapchain copy (screenshots)
-
-    VkCommandPool pool_ = VK_NULL_HANDLE;
-    VkCommandBuffer cmd_ = VK_NULL_HANDLE;
-    VkSemaphore acquired_ = VK_NULL_HANDLE;
-    VkFence fence_ = VK_NULL_HANDLE;
+    std::vector<std::unique_ptr<FrameSlot>> frames_; // FRAMES_IN_FLIGHT
+    uint64_t frame_ = 0;                             // frames drawn; slot frame_ % FRAMES_IN_FLIGHT next
 };
 
 } // namespace nbvh::viewer

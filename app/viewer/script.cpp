@@ -66,12 +66,17 @@ const char* view_mode_name(ViewMode mode) {
     case ViewMode::split: return "split";
     case ViewMode::difference: return "difference";
     case ViewMode::flip: return "flip";
+    case ViewMode::loss: return "loss";
     }
     return "image";
 }
 
+bool needs_reference(ViewMode mode) {
+    return mode == ViewMode::split || mode == ViewMode::difference || mode == ViewMode::flip;
+}
+
 bool parse_view_mode(const std::string& name, ViewMode* mode) {
-    for (ViewMode m : {ViewMode::image, ViewMode::split, ViewMode::difference, ViewMode::flip})
+    for (ViewMode m : {ViewMode::image, ViewMode::split, ViewMode::difference, ViewMode::flip, ViewMode::loss})
         if (name == view_mode_name(m)) {
             *mode = m;
             return true;
@@ -81,7 +86,7 @@ bool parse_view_mode(const std::string& name, ViewMode* mode) {
 
 const std::vector<std::string>& script_setting_keys() {
     static const std::vector<std::string> keys = {
-        "spp", "max_depth", "max_spp", "exposure", "ui", "neural", "lod", "nodes", "secondary_lod",
+        "spp", "max_depth", "max_spp", "exposure", "ui", "neural", "lod", "nodes", "secondary_lod", "max_leaves",
         "override_material", "roughness", "metallic", "view", "split", "gain", "compare_every", "train_steps",
         "train_nodes", "train_batch", "train_hash_log2", "train_lods", "train_threads", "train_snapshot",
         "train_backend"};
@@ -104,12 +109,13 @@ PanelActions apply_setting(ViewSettings& s, const std::string& key, const std::s
         if (!lod_node_counts.empty()) s.lod = lod_for_node_count(lod_node_counts, uint32_t(nodes));
         act.rebuild = true;
     } else if (key == "secondary_lod") s.secondary_lod = int_in(key, v, -1, 7), act.rebuild = true;
+    else if (key == "max_leaves") s.max_leaves = int_in(key, v, 1, 256), act.rebuild = true;
     else if (key == "override_material") s.override_material = on_off(key, v), act.rebuild = true;
     else if (key == "roughness") s.roughness = float_in(key, v, 0.0f, 1.0f), act.rebuild = true;
     else if (key == "metallic") s.metallic = float_in(key, v, 0.0f, 1.0f), act.rebuild = true;
     else if (key == "view") {
         if (!parse_view_mode(v, &s.view))
-            throw Error("set view '" + v + "': expected image, split, difference or flip");
+            throw Error("set view '" + v + "': expected image, split, difference, flip or loss");
         act.rebuild = true;
     } else if (key == "split") s.split = float_in(key, v, 0.0f, 1.0f);
     else if (key == "gain") s.gain = float_in(key, v, 1.0f, 64.0f);

@@ -10,6 +10,12 @@ namespace {
 
 double mib(uint64_t bytes) { return double(bytes) / double(1u << 20); }
 
+// Share of the path rays that spent their whole leaf budget (--neural-max-leaves) in the last frame.
+double leaf_cap_fraction(const render::RenderStats& s) {
+    const uint64_t rays = s.rays_primary + s.rays_secondary;
+    return rays ? double(s.neural_leaf_cap_rays) / double(rays) : 0.0;
+}
+
 void pass_table(const char* id, const render::RenderStats& s) {
     if (!ImGui::BeginTable(id, 2, ImGuiTableFlags_SizingStretchProp | ImGuiTableFlags_RowBg)) return;
     for (const auto& [name, ms] : s.pass_ms) {
@@ -33,7 +39,9 @@ nlohmann::json render_json(const render::RenderStats& s) {
                        {"queries", s.neural_queries},
                        {"queries_per_ray", s.neural_queries_per_ray()},
                        {"query_gpu_ms", s.neural_query_ms},
-                       {"queries_per_second", s.neural_queries_per_second()}};
+                       {"queries_per_second", s.neural_queries_per_second()},
+                       {"leaf_cap_rays", s.neural_leaf_cap_rays},
+                       {"leaf_cap_fraction", leaf_cap_fraction(s)}};
     return j;
 }
 
@@ -57,6 +65,10 @@ void draw_stats_panel(const StatsView& v) {
         if (!v.main->neural_path.empty())
             ImGui::Text("neural %s: %.2f queries/ray, %.3g queries/s", v.main->neural_path.c_str(),
                         v.main->neural_queries_per_ray(), v.main->neural_queries_per_second());
+        if (!v.main->neural_path.empty())
+            ImGui::Text("leaf-cap hits %llu rays (%.3f %% of path rays) at %d leaves per ray",
+                        (unsigned long long)v.main->neural_leaf_cap_rays, 100.0 * leaf_cap_fraction(*v.main),
+                        v.settings->max_leaves);
     }
     if (v.reference)
         ImGui::Text("classical reference: %u spp, %.2f ms wall, %.2f ms GPU", info.reference_samples,
@@ -72,8 +84,8 @@ void draw_stats_panel(const StatsView& v) {
             ImGui::Text("model %.2f MiB (%u assets; this LoD alone %.2f MiB): %.1fx smaller", mib(m.model_bytes),
                         m.assets, mib(m.lod_bytes), double(m.classical_bytes) / double(m.model_bytes));
     }
-    ImGui::Text("renderer builds %u (+%u reference), live setting changes %u", info.renderer_builds,
-                v.reference_builds, info.live_updates);
+    ImGui::Text("renderer builds %u (+%u reference), live setting changes %u, model swaps %u",
+                info.renderer_builds, v.reference_builds, info.live_updates, info.model_swaps);
     if (v.main && ImGui::CollapsingHeader("GPU time per pass (last frame)")) pass_table("main passes", *v.main);
     if (v.reference && ImGui::CollapsingHeader("classical reference passes")) pass_table("ref passes", *v.reference);
     ImGui::End();
@@ -100,6 +112,8 @@ nlohmann::json stats_json(const StatsView& v) {
     j["renderer_builds"] = i.renderer_builds;
     j["reference_builds"] = v.reference_builds;
     j["live_updates"] = i.live_updates;
+    j["model_swaps"] = i.model_swaps;
+    j["max_leaves"] = s.max_leaves;
     j["has_model"] = i.has_model;
     j["lod_node_counts"] = i.lod_node_counts;
     j["status"] = i.status;
@@ -112,6 +126,7 @@ nlohmann::json stats_json(const StatsView& v) {
                    {"classical_bytes", v.memory.classical_bytes},
                    {"assets", v.memory.assets},
                    {"neural_instances", v.memory.neural_instances}};
+    j["loss_view"] = {{"available", i.has_node_loss}, {"leaves", i.loss_leaves}, {"lo", i.loss_lo}, {"hi", i.loss_hi}};
     j["training"] = {{"state", i.train_state},     {"step", i.train_step},   {"steps", i.train_steps},
                      {"nodes", i.train_nodes},     {"loss", i.train_loss},   {"snapshots", i.train_snapshots},
                      {"loss_history", i.train_loss_history}};

@@ -1,8 +1,9 @@
 // The viewer's stats window (issue 13 "Stats panel"): per-pass GPU times of the last frame of each
 // renderer, rays/s, neural queries per ray and per second, the model's memory against the meshes + BLAS
-// it replaces (compression), and the FLIP of the hybrid view against the classical reference; and the
-// same numbers as JSON for scripts (`report`). Leaf-cap hits (rays that hit the per-ray leaf budget) are
-// not shown: the renderer does not count them yet (engine/render/neural_stage, not the viewer's).
+// it replaces (compression), leaf-cap hits (path rays that spent their whole leaf budget, counted on the
+// GPU: RenderStats::neural_leaf_cap_rays), the FLIP of the hybrid view against the classical reference,
+// and the build / setting-change / model-swap counters; and the same numbers as JSON for scripts
+// (`report`).
 #pragma once
 #include <nlohmann/json.hpp>
 

@@ -26,14 +26,17 @@ void draw_compare_section(ViewSettings& s, const PanelInfo& info, PanelActions& 
     ImGui::Separator();
     ImGui::TextUnformatted("compare with the classical reference");
     int mode = int(s.view);
-    const char* modes[] = {"image", "split (hybrid | classical)", "difference", "FLIP"};
-    if (ImGui::Combo("view", &mode, modes, 4)) {
+    const char* modes[] = {"image", "split (hybrid | classical)", "difference", "FLIP", "loss per node"};
+    if (ImGui::Combo("view", &mode, modes, info.has_node_loss ? 5 : 4)) {
         s.view = ViewMode(mode);
         act.rebuild = true;
     }
     if (s.view == ViewMode::split) ImGui::SliderFloat("split", &s.split, 0.0f, 1.0f, "%.2f (or drag the line)");
     if (s.view == ViewMode::difference) ImGui::SliderFloat("gain", &s.gain, 1.0f, 64.0f, "x%.0f");
-    if (s.view != ViewMode::image) {
+    if (s.view == ViewMode::loss)
+        ImGui::Text("%u leaves seen; colour: training loss %.3g (blue) .. %.3g (red), log", info.loss_leaves,
+                    info.loss_lo, info.loss_hi);
+    if (needs_reference(s.view)) {
         ImGui::SliderInt("compare every", &s.compare_every, 1, 240, "%d frames");
         ImGui::Text("classical %u spp, %.1f ms/frame", info.reference_samples, info.reference_frame_ms);
         if (info.flip_mean >= 0.0)
@@ -91,7 +94,8 @@ PanelActions draw_panel(ViewSettings& s, const PanelInfo& info) {
     ImGui::TextDisabled("%s", info.device.c_str());
     ImGui::Text("frame %.1f ms  |  %u spp", info.frame_ms, info.samples);
     ImGui::Text("%.3g rays/s (GPU)", info.rays_per_second);
-    ImGui::Text("renderer builds %u, live setting changes %u", info.renderer_builds, info.live_updates);
+    ImGui::Text("renderer builds %u, live changes %u, model swaps %u", info.renderer_builds, info.live_updates,
+                info.model_swaps);
     if (ImGui::Button("reset camera (R)")) act.reset_camera = true;
     ImGui::SameLine();
     if (ImGui::Button("restart")) act.reset_accumulation = true;
@@ -121,6 +125,8 @@ PanelActions draw_panel(ViewSettings& s, const PanelInfo& info) {
             if (ImGui::IsItemDeactivatedAfterEdit()) act.rebuild = true;
         }
         ImGui::SliderInt("secondary LoD", &s.secondary_lod, -1, lods - 1, s.secondary_lod < 0 ? "same" : "%d");
+        if (ImGui::IsItemDeactivatedAfterEdit()) act.rebuild = true;
+        ImGui::SliderInt("leaf budget", &s.max_leaves, 1, 256, "%d leaves / ray");
         if (ImGui::IsItemDeactivatedAfterEdit()) act.rebuild = true;
         ImGui::EndDisabled();
         // Neural surfaces are shaded with their asset's glTF material unless overridden here.

@@ -13,10 +13,14 @@ namespace nbvh::viewer {
 // What the window shows. image: the main renderer (hybrid, or classical with `neural` off); the
 // compare views need a model and add a classical reference renderer for the same camera:
 // split (hybrid left of the split line, classical right), difference (|hybrid - classical| of the
-// display bytes, times `gain`) and flip (LDR-FLIP heat map, hybrid vs classical).
-enum class ViewMode { image, split, difference, flip };
+// display bytes, times `gain`) and flip (LDR-FLIP heat map, hybrid vs classical). loss needs a model from
+// live training and no reference: every N-BVH leaf seen by a primary ray in its training loss, false
+// colour (paper Fig. 4; loss_view.h).
+enum class ViewMode { image, split, difference, flip, loss };
 const char* view_mode_name(ViewMode mode);
 bool parse_view_mode(const std::string& name, ViewMode* mode); // false for an unknown name
+// Whether the view shows a classical reference beside the main renderer (split, difference, flip).
+bool needs_reference(ViewMode mode);
 
 // Live training options (live_training.h): the CPU defaults of `nbvh train` scaled down for a view.
 struct TrainSettings {
@@ -41,6 +45,7 @@ struct ViewSettings {
     bool neural = true;
     int lod = 0;               // primary-ray LoD (0 = finest cut)
     int secondary_lod = -1;    // after the first hit; -1: same as lod
+    int max_leaves = 8;        // leaf budget per ray (NeuralRenderOptions::max_rounds, --neural-max-leaves)
     bool override_material = false; // else the assets' glTF materials
     float roughness = 0.5f, metallic = 0.0f;
     // Compare views (with a model).
@@ -59,6 +64,7 @@ struct PanelInfo {
     double rays_per_second = 0.0;  // last frame, GPU time
     uint32_t renderer_builds = 0;  // renderers built (scene upload, pipelines)
     uint32_t live_updates = 0;     // setting changes applied as uploads (no rebuild)
+    uint32_t model_swaps = 0;      // models replaced as uploads (same scene and BVHs, no rebuild)
     bool has_model = false;
     std::vector<uint32_t> lod_node_counts; // N-BVH nodes per LoD (index = LoD)
     std::string neural_path;       // MLP kernel in use (hybrid only)
@@ -76,6 +82,10 @@ struct PanelInfo {
     double train_loss = 0.0, train_eta_s = 0.0;
     uint32_t train_snapshots = 0;  // models swapped into the view
     std::vector<float> train_loss_history;
+    // Loss view (loss_view.h): whether the model shown has per-node losses, and the last image's range.
+    bool has_node_loss = false;
+    float loss_lo = 0.0f, loss_hi = 0.0f; // colour scale (log), of the leaves seen
+    uint32_t loss_leaves = 0;             // distinct leaves seen in the loss view
 };
 
 struct PanelActions {

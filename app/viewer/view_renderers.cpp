@@ -28,7 +28,7 @@ bool same_main(const render::RenderOptions& a, const render::RenderOptions& b) {
     const render::NeuralRenderOptions &n = a.neural, &m = b.neural;
     return a.width == b.width && a.height == b.height && a.max_depth == b.max_depth && n.model == m.model &&
            n.classical == m.classical && n.lod == m.lod && n.secondary_lod == m.secondary_lod &&
-           n.roughness == m.roughness && n.metallic == m.metallic;
+           n.max_rounds == m.max_rounds && n.roughness == m.roughness && n.metallic == m.metallic;
 }
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -38,7 +38,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 } // namespace
 
 bool is_compare_view(const ViewerScene& view, const ViewSettings& s) {
-    return view.model != nullptr && s.view != ViewMode::image;
+    return view.model != nullptr && needs_reference(s.view);
 }
 
 render::RenderOptions main_options(const ViewerScene& view, const ViewSettings& s, uint32_t width, uint32_t height) {
@@ -46,9 +46,11 @@ render::RenderOptions main_options(const ViewerScene& view, const ViewSettings& 
     if (!view.model) return o;
     const int lods = int(std::max(1u, view.model->lod_count));
     o.neural.model = view.model.get(); // also when classical: apply() switches only within one model
-    o.neural.classical = !s.neural && !is_compare_view(view, s);
+    // The compare and loss views show the hybrid render whatever `neural` says.
+    o.neural.classical = !s.neural && s.view == ViewMode::image;
     o.neural.lod = uint32_t(std::clamp(s.lod, 0, lods - 1));
     o.neural.secondary_lod = std::min(s.secondary_lod, lods - 1);
+    o.neural.max_rounds = uint32_t(std::clamp(s.max_leaves, 1, 256));
     set_overrides(s, o);
     return o;
 }
@@ -74,6 +76,7 @@ std::string ViewRenderers::configure(const ViewerScene& view, const ViewSettings
             // Nothing the main renderer uses changed (e.g. split -> FLIP view): its film keeps going.
         } else if (main_ && main_->apply(o)) {
             live_updates_++;
+            if (o.neural.model != main_options_.neural.model) model_swaps_++;
         } else {
             // With a model the renderer is built hybrid, so that neural on/off is an upload afterwards
             // (a classical-built renderer has no neural passes to switch to).
@@ -83,6 +86,7 @@ std::string ViewRenderers::configure(const ViewerScene& view, const ViewSettings
             auto next = std::make_unique<render::WavefrontRenderer>(ctx_, view.scene, view.accel, view.env, camera,
                                                                     first);
             if (first.neural.classical != o.neural.classical) NBVH_CHECK(next->apply(o));
+            ctx_.wait_idle(); // frames in flight may still read the old renderer's output (film_stage.h)
             main_ = std::move(next);
             builds_++;
         }
@@ -101,8 +105,10 @@ std::string ViewRenderers::configure(const ViewerScene& view, const ViewSettings
     if (reference_ && same(r, reference_options_)) return refused; // its film keeps accumulating
     try {
         if (!(reference_ && reference_->apply(r))) {
-            reference_ = std::make_unique<render::WavefrontRenderer>(ctx_, view.scene, view.accel, view.env,
-                                                                     camera, r);
+            auto next = std::make_unique<render::WavefrontRenderer>(ctx_, view.scene, view.accel, view.env,
+                                                                    camera, r);
+            ctx_.wait_idle();
+            reference_ = std::move(next);
             reference_builds_++;
         }
         reference_options_ = r;
@@ -150,6 +156,7 @@ void ViewRenderers::render(uint32_t spp, uint32_t max_samples, PanelInfo& info) 
 }
 
 void ViewRenderers::clear() {
+    if (main_ || reference_) ctx_.wait_idle();
     main_.reset();
     reference_.reset();
     view_ = nullptr;

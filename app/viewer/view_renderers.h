@@ -44,6 +44,9 @@ public:
     uint32_t builds() const { return builds_; }
     uint32_t reference_builds() const { return reference_builds_; }
     uint32_t live_updates() const { return live_updates_; }
+    uint32_t model_swaps() const { return model_swaps_; } // live updates that replaced the model
+    // The model the main renderer renders with (as last applied; null: none).
+    const NeuralModel* main_model() const { return main_ ? main_options_.neural.model : nullptr; }
 
 private:
     const vk::Context& ctx_;
@@ -52,7 +55,7 @@ private:
     render::RenderOptions main_options_, reference_options_; // as last applied
     bool compare_ = false;
     render::RenderStats main_stats_, reference_stats_;
-    uint32_t builds_ = 0, reference_builds_ = 0, live_updates_ = 0;
+    uint32_t builds_ = 0, reference_builds_ = 0, live_updates_ = 0, model_swaps_ = 0;
 };
 
 // The main renderer's options for `settings` (hybrid when the view has a model and neural is on or a

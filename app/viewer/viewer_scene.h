@@ -17,6 +17,8 @@ struct ViewerScene {
     std::string source;                       // "default" or the glTF path, as given
     std::string model_name;                   // model path ("" without a model)
     std::shared_ptr<const NeuralModel> model; // answers the neural instances (hybrid renders)
+    // The training loss of each model node (live training, live_training.h; NaN: none), else null.
+    std::shared_ptr<const std::vector<float>> node_loss;
     Scene scene;                              // split by material and bound to the model when there is one
     SceneAccel accel;
     Environment env;

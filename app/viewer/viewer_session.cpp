@@ -40,17 +40,10 @@ std::unique_ptr<ViewerScene> ViewerSession::replace_view(std::unique_ptr<ViewerS
     std::unique_ptr<ViewerScene> old = std::move(view_);
     view_ = std::move(next);
     info_.scene = view_->source;
-    info_.has_model = view_->model != nullptr;
-    info_.lod_node_counts = view_->lod_node_counts();
     info_.can_train = view_->has_neural_instances();
     info_.flip_mean = -1.0;
-    if (view_->model) {
-        const int lods = int(std::max(1u, view_->model->lod_count));
-        settings_.lod = std::min(settings_.lod, lods - 1);
-        settings_.secondary_lod = std::min(settings_.secondary_lod, lods - 1);
-    } else {
-        settings_.view = ViewMode::image;
-    }
+    set_model_info();
+    if (!view_->model) settings_.view = ViewMode::image;
     if (!keep_camera) camera_ = OrbitCamera(view_->home);
     refresh_memory();
     rebuild_ = true;
@@ -75,22 +68,51 @@ void ViewerSession::switch_view(std::unique_ptr<ViewerScene> next, bool keep_cam
     }
 }
 
-void ViewerSession::swap_model(std::shared_ptr<const NeuralModel> model, const std::string& name) {
-    if (view_->model && same_assets(*view_->model, *model)) {
-        // Same assets: the bound scene and its BVHs stay; the renderers are built for the new model
-        // (WavefrontRenderer::apply cannot change a model) before the old one is released.
-        renderers_.clear();
-        comparer_.invalidate();
-        view_->model = std::move(model);
-        view_->model_name = name;
-        info_.lod_node_counts = view_->lod_node_counts();
-        settings_.lod = std::min(settings_.lod, int(view_->model->lod_count) - 1);
-        settings_.secondary_lod = std::min(settings_.secondary_lod, int(view_->model->lod_count) - 1);
-        refresh_memory();
-        rebuild_ = true;
+void ViewerSession::set_model_info() {
+    info_.has_model = view_->model != nullptr;
+    info_.has_node_loss = view_->node_loss != nullptr;
+    info_.lod_node_counts = view_->lod_node_counts();
+    if (view_->model) {
+        const int lods = int(std::max(1u, view_->model->lod_count));
+        settings_.lod = std::min(settings_.lod, lods - 1);
+        settings_.secondary_lod = std::min(settings_.secondary_lod, lods - 1);
+    }
+    if (!view_->node_loss && settings_.view == ViewMode::loss) settings_.view = ViewMode::image;
+    loss_stale_ = true;
+}
+
+void ViewerSession::swap_model(std::shared_ptr<const NeuralModel> model, const std::string& name,
+                               std::shared_ptr<const std::vector<float>> node_loss) {
+    if (!(view_->model && same_assets(*view_->model, *model))) {
+        auto next = with_model(*view_, std::move(model), name); // binds the scene, builds its BVHs
+        next->node_loss = std::move(node_loss);
+        switch_view(std::move(next), true);
+        set_model_info();
         return;
     }
-    switch_view(with_model(*view_, std::move(model), name), true);
+    // Same assets: the bound scene and its BVHs stay, the renderer takes the model as an upload
+    // (WavefrontRenderer::apply); the classical reference of a compare view keeps its film. The old
+    // model stays alive until the renderer has let go of it.
+    ViewerScene& v = *view_;
+    std::shared_ptr<const NeuralModel> old = v.model;
+    std::shared_ptr<const std::vector<float>> old_loss = v.node_loss;
+    const std::string old_name = v.model_name;
+    const ViewSettings old_settings = settings_;
+    v.model = std::move(model);
+    v.model_name = name;
+    v.node_loss = std::move(node_loss);
+    set_model_info();
+    configure();
+    if (renderers_.main() && renderers_.main_model() != v.model.get()) { // refused: the old model stays
+        const std::string why = info_.status;
+        v.model = std::move(old);
+        v.model_name = old_name;
+        v.node_loss = std::move(old_loss);
+        settings_ = old_settings;
+        set_model_info();
+        configure();
+        throw Error(why.empty() ? "the model could not be swapped in" : why);
+    }
 }
 
 void ViewerSession::open_file(const std::string& path) {
@@ -99,9 +121,14 @@ void ViewerSession::open_file(const std::string& path) {
         const float aspect = float(width_) / float(std::max(1u, height_));
         if (kind == DropKind::model) {
             auto model = std::make_shared<const NeuralModel>(load_model(path));
-            auto next = with_model(*view_, model, path); // refused when it does not match the scene
-            trainer_.stop();
-            switch_view(std::move(next), true);
+            if (view_->model && same_assets(*view_->model, *model)) {
+                trainer_.stop();
+                swap_model(std::move(model), path, nullptr); // an upload: scene and BVHs stay
+            } else {
+                auto next = with_model(*view_, model, path); // refused when it does not match the scene
+                trainer_.stop();
+                switch_view(std::move(next), true);
+            }
         } else {
             std::unique_ptr<ViewerScene> next;
             std::string note;
@@ -128,6 +155,7 @@ void ViewerSession::configure() {
     const Camera cam = camera_.camera();
     info_.status = renderers_.configure(*view_, settings_, width_, height_, cam);
     comparer_.invalidate();
+    loss_stale_ = true;
     info_.flip_mean = -1.0;
     refresh_memory();
     rebuild_ = false;
@@ -222,9 +250,10 @@ bool ViewerSession::begin_frame(uint32_t ww, uint32_t wh, std::vector<std::strin
     // ended here has nothing left to take after this frame's take_model.
     const bool training_ended = !trainer_.active();
     // A newer model from live training goes into the view (the final one included).
-    if (auto model = trainer_.take_model()) {
+    std::shared_ptr<const std::vector<float>> node_loss;
+    if (auto model = trainer_.take_model(&node_loss)) {
         try {
-            swap_model(std::move(model), "live training");
+            swap_model(std::move(model), "live training", std::move(node_loss));
         } catch (const Error& e) {
             fail(e.what());
         }
@@ -242,8 +271,11 @@ bool ViewerSession::begin_frame(uint32_t ww, uint32_t wh, std::vector<std::strin
 
     if (rebuild_) configure();
     if (camera_moved_ || restart_) renderers_.set_camera(camera_.camera());
+    loss_stale_ |= camera_moved_;
     camera_moved_ = restart_ = false;
     renderers_.render(uint32_t(settings_.spp_per_frame), uint32_t(std::max(0, settings_.max_samples)), info_);
+    info_.model_swaps = renderers_.model_swaps();
+    update_loss_view();
     if (const render::WavefrontRenderer* ref = renderers_.reference()) {
         comparer_.update(*renderers_.main(), *ref, settings_);
         if (comparer_.has_result()) {
@@ -264,6 +296,18 @@ bool ViewerSession::begin_frame(uint32_t ww, uint32_t wh, std::vector<std::strin
     info_.train_snapshots = ts.snapshots;
     info_.train_loss_history = ts.loss_history;
     return !script_over;
+}
+
+// The loss view's image, made again when what it shows changed (loss_view.h: one traced ray a pixel).
+void ViewerSession::update_loss_view() {
+    render::WavefrontRenderer* main = renderers_.main();
+    if (settings_.view != ViewMode::loss || !loss_stale_ || !main || !main->hybrid() || !view_->node_loss) return;
+    loss_ = make_loss_image(*main, *view_, *view_->node_loss, camera_.camera(), uint32_t(std::max(0, settings_.lod)),
+                            main->width(), main->height());
+    info_.loss_lo = loss_.lo;
+    info_.loss_hi = loss_.hi;
+    info_.loss_leaves = loss_.leaves;
+    loss_stale_ = false;
 }
 
 StatsView ViewerSession::stats_view() const {
@@ -299,6 +343,10 @@ FilmSource ViewerSession::film() const {
     f.height = main->height();
     f.exposure = settings_.exposure;
     f.tone_map = ToneMap::aces; // as nbvh render's PNGs
+    if (settings_.view == ViewMode::loss) {
+        if (!loss_stale_ && loss_.width == f.width && loss_.height == f.height) f.rgba8 = &loss_.rgba8;
+        return f;
+    }
     const render::WavefrontRenderer* ref = renderers_.reference();
     if (!ref || ref->width() != f.width || ref->height() != f.height) return f;
     if (settings_.view == ViewMode::split) {

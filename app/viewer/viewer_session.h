@@ -10,6 +10,7 @@
 
 #include "app/viewer/compare.h"
 #include "app/viewer/live_training.h"
+#include "app/viewer/loss_view.h"
 #include "app/viewer/orbit_camera.h"
 #include "app/viewer/presenter.h"
 #include "app/viewer/script.h"
@@ -53,7 +54,10 @@ public:
 private:
     std::unique_ptr<ViewerScene> replace_view(std::unique_ptr<ViewerScene> next, bool keep_camera);
     void switch_view(std::unique_ptr<ViewerScene> next, bool keep_camera);
-    void swap_model(std::shared_ptr<const NeuralModel> model, const std::string& name);
+    void swap_model(std::shared_ptr<const NeuralModel> model, const std::string& name,
+                    std::shared_ptr<const std::vector<float>> node_loss);
+    void set_model_info();
+    void update_loss_view();
     void configure();
     void fail(const std::string& what); // status line + log, the viewer keeps running
     void refresh_memory();
@@ -75,6 +79,8 @@ private:
     bool wait_training_ = false;
     std::chrono::steady_clock::time_point wait_deadline_;
     std::string pending_shot_;
+    LossImage loss_;          // the loss view's image (loss_view.h)
+    bool loss_stale_ = true;  // camera, LoD, model or size changed since it was made
 };
 
 } // namespace nbvh::viewer

@@ -108,12 +108,17 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
     : ctx_(ctx), model_(ctx, model), kernel_(choose_neural_kernel(ctx.features(), o.path)),
       rounds_(o.max_rounds), capacity_(ray_capacity) {
     set_params(o);
-    // The asset table: each asset's subtree root per LoD (LoDs past the model's repeat its coarsest) and
-    // the material of the scene mesh it answers (one material per asset after bind_model_to_scene).
-    assets_.resize(model.assets.size());
-    for (uint32_t a = 0; a < assets_.size(); ++a) {
-        GpuNeuralAsset& g = assets_[a];
-        for (uint32_t l = 0; l < NB_NEURAL_MAX_LODS; ++l) g.roots[l] = model_.lod_root(l, a);
+    assets_ = asset_table(model, model_, scene);
+}
+
+std::vector<GpuNeuralAsset> NeuralStage::asset_table(const NeuralModel& model, const NeuralModelGpu& gpu,
+                                                     const Scene& scene) {
+    // Each asset's subtree root per LoD (LoDs past the model's repeat its coarsest) and the material of
+    // the scene mesh it answers (one material per asset after bind_model_to_scene).
+    std::vector<GpuNeuralAsset> assets(model.assets.size());
+    for (uint32_t a = 0; a < assets.size(); ++a) {
+        GpuNeuralAsset& g = assets[a];
+        for (uint32_t l = 0; l < NB_NEURAL_MAX_LODS; ++l) g.roots[l] = gpu.lod_root(l, a);
         g.material = 0;
         g.metallic = 0.0f;
         g.roughness = 1.0f;
@@ -127,6 +132,24 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
             }
         if (g.material >= std::max<size_t>(scene.materials.size(), 1)) g.material = 0;
     }
+    return assets;
+}
+
+void NeuralStage::set_model(const NeuralModel& model, const Scene& scene, const NeuralRenderOptions& o,
+                            std::vector<vk::Buffer>& buffers) {
+    NeuralModelGpu next(ctx_, model); // throws before anything changes
+    std::vector<GpuNeuralAsset> assets = asset_table(model, next, scene);
+    model_ = std::move(next);
+    assets_ = std::move(assets);
+    set_params(o);
+    install_model(buffers);
+}
+
+const std::vector<uint32_t>& NeuralStage::model_bindings() {
+    static const std::vector<uint32_t> b = {NB_BIND_NEURAL_LEVELS, NB_BIND_NEURAL_GRID,   NB_BIND_NEURAL_MLP,
+                                            NB_BIND_NEURAL_MLP_T,  NB_BIND_NBVH_NODES,    NB_BIND_NBVH_BOUNDS,
+                                            NB_BIND_NEURAL_PARAMS, NB_BIND_NEURAL_ASSETS};
+    return b;
 }
 
 void NeuralStage::set_params(const NeuralRenderOptions& o) {
@@ -155,10 +178,16 @@ const char* NeuralStage::query_shader() const {
     return kernel_.fp32_accumulate ? coopmat_fp32_shader("query") : "passes/neural_query_coop16.comp";
 }
 
-void NeuralStage::install(std::vector<vk::Buffer>& buffers) {
+void NeuralStage::install_model(std::vector<vk::Buffer>& buffers) {
     if (buffers.size() < NB_NEURAL_BINDING_END) buffers.resize(NB_NEURAL_BINDING_END);
     model_.move_into(buffers[NB_BIND_NEURAL_LEVELS], buffers[NB_BIND_NEURAL_GRID], buffers[NB_BIND_NEURAL_MLP],
                      buffers[NB_BIND_NEURAL_MLP_T], buffers[NB_BIND_NBVH_NODES], buffers[NB_BIND_NBVH_BOUNDS]);
+    buffers[NB_BIND_NEURAL_PARAMS] = vk::make_buffer(ctx_, std::vector<GpuNeuralParams>{params_}, "neural params");
+    buffers[NB_BIND_NEURAL_ASSETS] = vk::make_buffer(ctx_, assets_, "neural assets");
+}
+
+void NeuralStage::install(std::vector<vk::Buffer>& buffers) {
+    install_model(buffers);
     // Two halves (ping-pong between a query round and the traversal that follows it) of
     // leaves_per_round pairs per ray.
     buffers[NB_BIND_PENDING_LEAVES] = vk::Buffer(ctx_, 2ull * params_.leaves_per_round * std::max(capacity_, 1u) * sizeof(GpuPendingLeaf),
@@ -166,8 +195,6 @@ void NeuralStage::install(std::vector<vk::Buffer>& buffers) {
     // Path rays at [0, capacity), shadow rays at [capacity, 2 capacity).
     buffers[NB_BIND_NEURAL_STATE] = vk::Buffer(ctx_, 2ull * std::max(capacity_, 1u) * sizeof(GpuNeuralRayState),
                                                vk::MemoryKind::device, 0, "neural ray state");
-    buffers[NB_BIND_NEURAL_PARAMS] = vk::make_buffer(ctx_, std::vector<GpuNeuralParams>{params_}, "neural params");
-    buffers[NB_BIND_NEURAL_ASSETS] = vk::make_buffer(ctx_, assets_, "neural assets");
     buffers[NB_BIND_NEURAL_COUNTERS] =
         vk::Buffer(ctx_, sizeof(GpuNeuralCounters), vk::MemoryKind::device, 0, "neural counters");
     buffers[NB_BIND_PENDING_LEAVES].fill(0u);

@@ -75,8 +75,17 @@ public:
                 uint32_t ray_capacity);
 
     // New per-render neural settings (LoDs, overrides, leaf budget, batched rounds, threshold) written
-    // into the params buffer. Leaves per round and the model cannot change here.
+    // into the params buffer. Leaves per round cannot change here.
     void update(const NeuralRenderOptions& options, vk::Buffer& params_buffer);
+    // Another model for the same scene (same network sizes; e.g. a live-training snapshot or a model
+    // file of the same assets): its buffers and asset table replace the current ones in `buffers` (the
+    // model bindings, NB_BIND_NEURAL_ASSETS and NB_BIND_NEURAL_PARAMS), with `options` applied; the ray
+    // state, pending queue and counters stay. Throws nbvh::Error (changing nothing) for a model whose
+    // network sizes differ from the renderer's.
+    void set_model(const NeuralModel& model, const Scene& scene, const NeuralRenderOptions& options,
+                   std::vector<vk::Buffer>& buffers);
+    // The bindings set_model() replaces (descriptor sets must be rebound to them).
+    static const std::vector<uint32_t>& model_bindings();
 
     // Moves the neural buffers into `buffers` (indexed by binding, resized to NB_NEURAL_BINDING_END):
     // NB_BIND_NEURAL_*, NB_BIND_NBVH_*, and the pending-leaf queue at NB_BIND_PENDING_LEAVES.
@@ -93,6 +102,10 @@ public:
 
 private:
     void set_params(const NeuralRenderOptions& options);
+    // The asset table: each asset's subtree root per LoD and the material of the scene mesh it answers.
+    static std::vector<GpuNeuralAsset> asset_table(const NeuralModel& model, const NeuralModelGpu& gpu,
+                                                   const Scene& scene);
+    void install_model(std::vector<vk::Buffer>& buffers);
 
     const vk::Context& ctx_;
     NeuralModelGpu model_;

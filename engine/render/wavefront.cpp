@@ -46,7 +46,7 @@ void set_camera_params(GpuFrameParams& p, const Camera& camera, float aspect) {
 WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene, const SceneAccel& accel,
                                      const Environment& environment, const Camera& camera,
                                      const RenderOptions& options)
-    : ctx_(ctx), scene_(&scene), options_(options) {
+    : ctx_(ctx), scene_(&scene), accel_(&accel), options_(options) {
     if (options_.width == 0 || options_.height == 0 || options_.width > 16384 || options_.height > 16384)
         throw Error(strfmt("image size %ux%u is out of range (1..16384 per side)", options_.width, options_.height));
     if (options_.spp == 0) throw Error("--spp must be at least 1");
@@ -183,6 +183,24 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     cmd_ = vk::CommandBuffer(ctx_, "wavefront");
 }
 
+// Another model for the same scene: the neural instances' records (asset index, atlas transforms) are
+// marked again for it and the model's buffers replaced; scene, BVHs, queues and pipelines stay.
+void WavefrontRenderer::swap_model(const NeuralRenderOptions& n) {
+    GpuSceneData marked;
+    marked.instances = data_.instances; // the hybrid records: kind, asset and transforms rewritten
+    marked.instance_to_scene = data_.instance_to_scene;
+    if (mark_neural_instances(*scene_, *accel_, *n.model, marked) == 0)
+        throw Error("the model answers no neural instance of the scene");
+    neural_->set_model(*n.model, *scene_, n, buffers_); // throws before changing anything on a bad model
+    data_.instances = std::move(marked.instances);
+    vk::Buffer& hybrid_instances = hybrid_ ? buffers_[NB_BIND_INSTANCES] : other_instances_;
+    hybrid_instances.upload(data_.instances);
+    for (vk::DescriptorSet& set : sets_)
+        if (set.handle() != VK_NULL_HANDLE)
+            for (uint32_t b : NeuralStage::model_bindings()) set.bind(b, buffers_[b]);
+    ++model_swaps_;
+}
+
 void WavefrontRenderer::make_timer() {
     timer_ = vk::GpuTimer(ctx_, 64 + (8 + (neural_ ? 6 * neural_->batched_rounds() + 8 : 0)) * options_.max_depth);
 }
@@ -190,15 +208,19 @@ void WavefrontRenderer::make_timer() {
 bool WavefrontRenderer::apply(const RenderOptions& o) {
     const RenderOptions& c = options_;
     const NeuralRenderOptions &n = o.neural, &cn = c.neural;
-    // What needs new buffers or pipelines: the film size and waves, another model, the MLP path, the
-    // pending-queue size, material overrides baked into a classical reference's triangles.
+    // What needs new buffers or pipelines: the film size and waves, a model where there was none (or
+    // none where there was one), the MLP path, the pending-queue size, material overrides baked into a
+    // classical reference's triangles. Another model of the same scene is an upload (swap_model).
     const bool overrides = n.roughness >= 0.0f || n.metallic >= 0.0f;
-    if (o.width != c.width || o.height != c.height || o.max_wave_pixels != c.max_wave_pixels || n.model != cn.model ||
-        n.path != cn.path || (n.model && effective_leaves_per_round(n) != neural_->leaves_per_round()) ||
+    const bool swap = n.model && cn.model && n.model != cn.model && neural_;
+    if (o.width != c.width || o.height != c.height || o.max_wave_pixels != c.max_wave_pixels ||
+        (n.model != cn.model && !swap) || n.path != cn.path ||
+        (n.model && effective_leaves_per_round(n) != neural_->leaves_per_round()) ||
         (n.classical && overrides) != classical_overrides_ || (n.model && !features_.neural && !n.classical) ||
         !(o.forced_features == c.forced_features))
         return false;
     if (n.model) validate(n, *scene_);
+    if (swap) swap_model(n);
     ++live_updates_;
     options_.max_depth = o.max_depth;
     options_.rr_start_depth = o.rr_start_depth;

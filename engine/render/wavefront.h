@@ -103,10 +103,15 @@ public:
     // with a model: hybrid <-> classical, LoDs, leaf budget, batched rounds, visibility threshold and the
     // material overrides of neural hits are uploads (params buffers, the bound instance array). Returns
     // false, changing nothing, when `options` differ in what needs new buffers or pipelines (size,
-    // waves, model, MLP path, leaves per round, overrides baked into a classical reference): build a
-    // new renderer then. Clears the film. Throws nbvh::Error on invalid neural options.
+    // waves, a model where there was none or the reverse, MLP path, leaves per round, overrides baked
+    // into a classical reference): build a new renderer then. Another model for the same scene (same
+    // assets; a live-training snapshot, a retrained file) is an upload too: its buffers and asset table
+    // replace the old ones and the neural instance records are marked again; scene, BVHs, queues and
+    // pipelines stay. Clears the film. Throws nbvh::Error on invalid neural options or a model that does
+    // not answer the scene (changing nothing).
     bool apply(const RenderOptions& options);
     uint64_t live_updates() const { return live_updates_; } // successful apply() calls
+    uint64_t model_swaps() const { return model_swaps_; }   // of which replaced the model
     bool hybrid() const { return hybrid_; }
     RenderResult render_progressive(uint32_t samples = 1, bool read_back = true);
     uint32_t accumulated_samples() const { return accumulated_; }
@@ -134,9 +139,11 @@ private:
     RenderResult render_samples(uint32_t first, uint32_t count, bool read_back = true);
 
     void make_timer();
+    void swap_model(const NeuralRenderOptions& options);
 
     const vk::Context& ctx_;
     const Scene* scene_ = nullptr; // the caller's, outlives the renderer (validation in apply())
+    const SceneAccel* accel_ = nullptr; // the caller's too (instance transforms for a model swap)
     RenderOptions options_;
     SceneFeatures features_;
     GpuSceneData data_;
@@ -151,7 +158,7 @@ private:
     bool hybrid_ = false;                 // neural instances through the N-BVH (else their triangles)
     bool classical_overrides_ = false;    // the classical reference's triangles carry material overrides
     vk::Buffer other_instances_;          // the instance array not bound (classical <-> hybrid)
-    uint64_t live_updates_ = 0;
+    uint64_t live_updates_ = 0, model_swaps_ = 0;
     vk::GpuTimer timer_;
     vk::CommandBuffer cmd_;
 };

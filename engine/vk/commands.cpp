@@ -73,13 +73,22 @@ CommandBuffer& CommandBuffer::end() {
     return *this;
 }
 
-void CommandBuffer::submit() {
+void CommandBuffer::submit(const SubmitSync& sync) {
     if (recording_) end();
     NBVH_CHECK_MSG(!in_flight_, "submit() of a command buffer still in flight");
     NBVH_VK_CHECK(vkResetFences(ctx_->device(), 1, &fence_));
     VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     submit.commandBufferCount = 1;
     submit.pCommandBuffers = &cmd_;
+    if (sync.wait) {
+        submit.waitSemaphoreCount = 1;
+        submit.pWaitSemaphores = &sync.wait;
+        submit.pWaitDstStageMask = &sync.wait_stage;
+    }
+    if (sync.signal) {
+        submit.signalSemaphoreCount = 1;
+        submit.pSignalSemaphores = &sync.signal;
+    }
     NBVH_VK_CHECK(vkQueueSubmit(ctx_->queue(), 1, &submit, fence_));
     in_flight_ = true;
 }
@@ -162,6 +171,11 @@ CommandBuffer& CommandBuffer::barrier(Barrier kind) {
         src = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
         dst = VK_PIPELINE_STAGE_HOST_BIT;
         break;
+    case Barrier::transfer_to_transfer:
+        b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        b.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+        src = dst = VK_PIPELINE_STAGE_TRANSFER_BIT;
+        break;
     }
     vkCmdPipelineBarrier(cmd_, src, dst, 0, 1, &b, 0, nullptr, 0, nullptr);
     return *this;
@@ -184,6 +198,49 @@ CommandBuffer& CommandBuffer::copy(const Buffer& src, const Buffer& dst, VkDevic
     return *this;
 }
 
+CommandBuffer& CommandBuffer::copy_to_image(const Buffer& src, VkDeviceSize src_offset, uint32_t row_length,
+                                            const Image& dst, uint32_t x, uint32_t y, uint32_t width,
+                                            uint32_t height) {
+    NBVH_CHECK(recording_);
+    NBVH_CHECK_MSG(x + width <= dst.width() && y + height <= dst.height() && width <= row_length,
+                   "image copy out of range");
+    const VkDeviceSize texel = texel_bytes(dst.format());
+    NBVH_CHECK_MSG(height == 0 || src_offset + (VkDeviceSize(height - 1) * row_length + width) * texel <= src.size(),
+                   "image copy reads past the buffer");
+    VkBufferImageCopy region{};
+    region.bufferOffset = src_offset;
+    region.bufferRowLength = row_length;
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageOffset = {int32_t(x), int32_t(y), 0};
+    region.imageExtent = {width, height, 1};
+    if (width == 0 || height == 0) return *this;
+    // GENERAL -> TRANSFER_DST_OPTIMAL -> GENERAL around the copy (the layer's convention, image.h).
+    const VkPipelineStageFlags all = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, t = VK_PIPELINE_STAGE_TRANSFER_BIT;
+    const VkAccessFlags rw = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+    transition(dst.handle(), VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, all, rw, t,
+               VK_ACCESS_TRANSFER_WRITE_BIT);
+    vkCmdCopyBufferToImage(cmd_, src.handle(), dst.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    transition(dst.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL, t,
+               VK_ACCESS_TRANSFER_WRITE_BIT, all, rw);
+    return *this;
+}
+
+CommandBuffer& CommandBuffer::transition(VkImage image, VkImageLayout from, VkImageLayout to,
+                                         VkPipelineStageFlags src_stage, VkAccessFlags src_access,
+                                         VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) {
+    NBVH_CHECK(recording_);
+    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.oldLayout = from;
+    b.newLayout = to;
+    b.srcAccessMask = src_access;
+    b.dstAccessMask = dst_access;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(cmd_, src_stage, dst_stage, 0, 0, nullptr, 0, nullptr, 1, &b);
+    return *this;
+}
+
 CommandBuffer& CommandBuffer::begin_pass(const std::string& name, GpuTimer* timer) {
     NBVH_CHECK(recording_);
     ctx_->begin_label(cmd_, name.c_str());
@@ -198,6 +255,29 @@ CommandBuffer& CommandBuffer::end_pass() {
     open_passes_.pop_back();
     if (timer) timer->end(cmd_, slot);
     ctx_->end_label(cmd_);
+    return *this;
+}
+
+// --- Semaphore ------------------------------------------------------------------------------------
+
+Semaphore::Semaphore(const Context& ctx, const std::string& name) : ctx_(&ctx) {
+    VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+    NBVH_VK_CHECK(vkCreateSemaphore(ctx.device(), &info, nullptr, &semaphore_));
+    ctx.set_name(VK_OBJECT_TYPE_SEMAPHORE, semaphore_, name);
+}
+
+Semaphore::~Semaphore() {
+    if (ctx_ && semaphore_) vkDestroySemaphore(ctx_->device(), semaphore_, nullptr);
+}
+
+Semaphore::Semaphore(Semaphore&& o) noexcept { *this = std::move(o); }
+
+Semaphore& Semaphore::operator=(Semaphore&& o) noexcept {
+    if (this != &o) {
+        if (ctx_ && semaphore_) vkDestroySemaphore(ctx_->device(), semaphore_, nullptr);
+        ctx_ = o.ctx_;
+        semaphore_ = std::exchange(o.semaphore_, VK_NULL_HANDLE);
+    }
     return *this;
 }
 

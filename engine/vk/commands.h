@@ -1,5 +1,6 @@
 // Command recording for compute work: a reusable command buffer with its own pool and fence,
-// dispatches, barriers, debug labels and timed passes.
+// dispatches, barriers, debug labels and timed passes; semaphores and image copies / layout
+// transitions for a presenter (app/viewer: frames in flight, one CommandBuffer + Semaphore per frame).
 //
 //   CommandBuffer cmd(ctx, "frame");
 //   GpuTimer timer(ctx);
@@ -14,6 +15,7 @@
 //   for (auto& [name, ms] : timer.results()) ...
 #pragma once
 #include "buffer.h"
+#include "image.h"
 #include "pipeline.h"
 
 #include <string>
@@ -32,6 +34,31 @@ enum class Barrier {
     transfer_to_compute, // fill/copy -> shader reads/writes
     compute_to_transfer, // shader writes -> copy/fill
     compute_to_host,     // shader/transfer writes -> host reads of a mapped buffer after the fence
+    transfer_to_transfer, // copy writes -> copy/blit reads and writes (images in GENERAL layout included)
+};
+
+// A binary semaphore (GPU-GPU ordering between submissions and presentation).
+class Semaphore {
+public:
+    Semaphore() = default;
+    explicit Semaphore(const Context& ctx, const std::string& name = "semaphore");
+    ~Semaphore();
+    Semaphore(Semaphore&& other) noexcept;
+    Semaphore& operator=(Semaphore&& other) noexcept;
+    Semaphore(const Semaphore&) = delete;
+    Semaphore& operator=(const Semaphore&) = delete;
+    VkSemaphore handle() const { return semaphore_; }
+
+private:
+    const Context* ctx_ = nullptr;
+    VkSemaphore semaphore_ = VK_NULL_HANDLE;
+};
+
+// What a submission waits for and signals besides its fence (VK_NULL_HANDLE: nothing).
+struct SubmitSync {
+    VkSemaphore wait = VK_NULL_HANDLE;
+    VkPipelineStageFlags wait_stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+    VkSemaphore signal = VK_NULL_HANDLE;
 };
 
 class CommandBuffer {
@@ -47,9 +74,12 @@ public:
     // Start recording (waits for a previous submission of this buffer, then resets it).
     CommandBuffer& begin();
     CommandBuffer& end();
-    // Submit (ending recording if needed); wait() blocks until the GPU is done.
-    void submit();
+    // Submit (ending recording if needed); wait() blocks until the GPU is done. `sync` adds a semaphore
+    // to wait for (at its stage) and one to signal. A submission's fence also covers everything
+    // submitted to the queue before it (Vulkan's fence-signal scope).
+    void submit(const SubmitSync& sync = {});
     void wait();
+    bool in_flight() const { return in_flight_; }
     void submit_and_wait() {
         submit();
         wait();
@@ -70,6 +100,14 @@ public:
                         VkDeviceSize bytes = VK_WHOLE_SIZE);
     CommandBuffer& copy(const Buffer& src, const Buffer& dst, VkDeviceSize bytes, VkDeviceSize src_offset = 0,
                         VkDeviceSize dst_offset = 0);
+    // Texels of rows `row_length` texels apart, starting at byte `src_offset` of `src`, into the
+    // width x height rectangle at (x, y) of `dst` (GENERAL layout before and after, as every Image; the
+    // copy itself goes through TRANSFER_DST_OPTIMAL, with the barriers that takes).
+    CommandBuffer& copy_to_image(const Buffer& src, VkDeviceSize src_offset, uint32_t row_length, const Image& dst,
+                                 uint32_t x, uint32_t y, uint32_t width, uint32_t height);
+    // A layout transition of a colour image this layer does not own (a swapchain image).
+    CommandBuffer& transition(VkImage image, VkImageLayout from, VkImageLayout to, VkPipelineStageFlags src_stage,
+                              VkAccessFlags src_access, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access);
 
     // A named region: debug label (RenderDoc/Nsight) and, with a timer, a timestamp pair. Nestable
     // for labels; the timer sums nested regions independently.

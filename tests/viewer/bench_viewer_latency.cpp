@@ -1,12 +1,17 @@
 // What a viewer setting change costs, in frames (issue 13: "a slider change costs no more than two
 // frames"), and the viewer's progressive frame against `nbvh render`'s (issue 13: "within 10 %").
 // Not a test: a benchmark executable; numbers only mean something on a GPU (lavapipe times say
-// nothing), measured in one run on one device. No window: the viewer's frame is the renderer's
-// render_progressive(1, no read-back) plus the display pass (its own submission here; in the viewer it
-// shares the presenter's), so swapchain and UI are not counted.
+// nothing), measured in one run on one device. No window (the GPU machine has no display): the viewer's
+// frame is the renderer's render_progressive(1, no read-back) plus the presenter's film stage recorded
+// into one of FRAMES_IN_FLIGHT frame slots and submitted without waiting (app/viewer/film_stage.h, the
+// presenter's own code), so swapchain, blit and UI are not counted. For comparison the same frame with
+// a blocking wait for the film stage (the viewer before frames in flight). A change is timed from the
+// settings call to the end of the first frame that shows it (its film stage done). Changes: the
+// sliders (apply()), and a model swap (apply() with another model of the same assets: the model file
+// loaded again, or --swap-model B.nbvh), each against a rebuild.
 //
-// Usage: nbvh_bench_viewer_latency SCENE|default MODEL.nbvh [--width 1920 --height 1080] [--frames 32]
-//        [--device auto|gpu|cpu] [--json OUT.json]
+// Usage: nbvh_bench_viewer_latency SCENE|default MODEL.nbvh [--swap-model B.nbvh] [--width 1920
+//        --height 1080] [--frames 32] [--device auto|gpu|cpu] [--json OUT.json]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -18,7 +23,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/viewer/display_pass.h"
+#include "app/viewer/film_stage.h"
 #include "assets/default_scene.h"
 #include "engine/bvh/scene_accel.h"
 #include "engine/core/error.h"
@@ -45,7 +50,7 @@ double median(std::vector<double> v) {
 }
 
 struct Args {
-    std::string scene, model, device = "auto", json;
+    std::string scene, model, swap_model, device = "auto", json;
     uint32_t width = 1920, height = 1080, frames = 32;
 };
 
@@ -63,6 +68,7 @@ Args parse(int argc, char** argv) {
         else if (s == "--frames") a.frames = std::max(4u, uint32_t(std::stoul(next())));
         else if (s == "--device") a.device = next();
         else if (s == "--json") a.json = next();
+        else if (s == "--swap-model") a.swap_model = next();
         else pos.push_back(s);
     }
     if (pos.size() != 2) throw Error("usage: nbvh_bench_viewer_latency SCENE|default MODEL.nbvh [options]");
@@ -76,6 +82,7 @@ Args parse(int argc, char** argv) {
 int main(int argc, char** argv) try {
     const Args a = parse(argc, argv);
     const NeuralModel model = load_model(a.model);
+    const NeuralModel other = load_model(a.swap_model.empty() ? a.model : a.swap_model); // another object
     Scene scene = a.scene == "default" ? assets::make_default_scene() : load_gltf(a.scene, {});
     bind_model_to_scene(scene, model, a.model);
     const SceneAccel accel = build_scene_accel(scene);
@@ -90,26 +97,42 @@ int main(int argc, char** argv) try {
     o.height = a.height;
     o.spp = 1;
     o.max_depth = 8;
-    o.neural.model = &model; // as the viewer: one renderer per model, settings through apply()
+    o.neural.model = &model; // as the viewer: one renderer, settings and models through apply()
     render::WavefrontRenderer r(ctx, scene, accel, env, camera, o);
-    viewer::DisplayPass display(ctx);
-    vk::Buffer packed(ctx, uint64_t(a.width) * a.height * 4, vk::MemoryKind::device, 0, "packed");
-    // One viewer frame: one sample into the film, then the display pass over the mean.
-    auto frame = [&] {
+    // The presenter's frame slots (film stage + command buffer each), driven as the presenter does.
+    std::vector<std::unique_ptr<viewer::FrameSlot>> slots;
+    for (uint32_t i = 0; i < viewer::FRAMES_IN_FLIGHT; ++i)
+        slots.push_back(std::make_unique<viewer::FrameSlot>(ctx, false, "bench frame"));
+    uint64_t frame_no = 0;
+    viewer::FilmSource film;
+    film.width = a.width;
+    film.height = a.height;
+    // One viewer frame: one sample into the film, then the film stage into the next slot, not waited
+    // for (frames in flight); `block` waits for it (the viewer before frames in flight).
+    auto frame = [&](bool block) -> viewer::FrameSlot& {
         r.render_progressive(1, false);
-        vk::CommandBuffer cmd(ctx, "display");
-        cmd.begin();
-        display.record(cmd.handle(), r.output(), packed, a.width * a.height, 0.0f, ToneMap::aces);
-        cmd.submit_and_wait();
+        viewer::FrameSlot& f = *slots[frame_no++ % slots.size()];
+        f.cmd.wait();
+        f.cmd.begin();
+        film.linear = &r.output();
+        f.film.record(f.cmd, film);
+        f.cmd.submit();
+        if (block) f.cmd.wait();
+        return f;
     };
-    for (int i = 0; i < 4; ++i) frame(); // warm-up (pipelines, caches, clocks)
-    std::vector<double> steady;
-    for (uint32_t i = 0; i < a.frames; ++i) {
-        const auto t0 = clock_type::now();
-        frame();
-        steady.push_back(ms_since(t0));
-    }
-    const double frame_ms = median(steady);
+    auto steady_frame_ms = [&](bool block) {
+        for (int i = 0; i < 4; ++i) frame(block); // warm-up (pipelines, caches, clocks)
+        std::vector<double> steady;
+        for (uint32_t i = 0; i < a.frames; ++i) {
+            const auto t0 = clock_type::now();
+            frame(block);
+            steady.push_back(ms_since(t0));
+        }
+        ctx.wait_idle();
+        return median(steady);
+    };
+    const double blocking_ms = steady_frame_ms(true);
+    const double frame_ms = steady_frame_ms(false);
 
     // Each change: apply() and the first frame of the new setting (what the user waits for), median of
     // several; the setting goes back and forth so every measurement is a real change.
@@ -118,35 +141,41 @@ int main(int argc, char** argv) try {
         std::function<void(render::RenderOptions&, bool)> set;
     };
     const uint32_t lods = std::max(1u, model.lod_count);
-    const std::vector<Change> changes = {
+    std::vector<Change> changes = {
         {"lod", [&](render::RenderOptions& x, bool b) { x.neural.lod = b ? lods - 1 : 0; }},
         {"secondary_lod", [&](render::RenderOptions& x, bool b) { x.neural.secondary_lod = b ? int32_t(lods - 1) : -1; }},
         {"neural_off", [](render::RenderOptions& x, bool b) { x.neural.classical = b; }},
         {"max_depth", [](render::RenderOptions& x, bool b) { x.max_depth = b ? 4 : 8; }},
         {"roughness_override", [](render::RenderOptions& x, bool b) { x.neural.roughness = b ? 0.3f : -1.0f; }},
     };
+    changes.push_back({"model_swap", [&](render::RenderOptions& x, bool b) { x.neural.model = b ? &other : &model; }});
     nlohmann::json rows = nlohmann::json::array();
     std::printf("device        %s\n", ctx.features().device_name.c_str());
-    std::printf("film          %ux%u, model %s (%u LoDs)\n", a.width, a.height, a.model.c_str(), lods);
-    std::printf("viewer frame  %.3f ms (median of %u: 1 spp + display pass)\n\n", frame_ms, a.frames);
+    std::printf("film          %ux%u, model %s (%u LoDs), swap model %s\n", a.width, a.height, a.model.c_str(), lods,
+                a.swap_model.empty() ? "(the same file, loaded again)" : a.swap_model.c_str());
+    std::printf("viewer frame  %.3f ms with %u frames in flight, %.3f ms blocking (median of %u: 1 spp + film stage)\n\n",
+                frame_ms, viewer::FRAMES_IN_FLIGHT, blocking_ms, a.frames);
     std::printf("%-20s %12s %12s %8s\n", "change", "apply ms", "to frame ms", "frames");
     for (const Change& c : changes) {
         std::vector<double> apply_ms, total_ms;
         for (uint32_t i = 0; i < 8; ++i) {
             render::RenderOptions x = o;
             c.set(x, i % 2 == 0);
+            ctx.wait_idle(); // from a quiet queue: the change's own cost
             const auto t0 = clock_type::now();
             if (!r.apply(x)) throw Error(std::string("apply refused the change ") + c.name);
             apply_ms.push_back(ms_since(t0));
-            frame();
+            frame(false).cmd.wait(); // the first frame showing the change, done
             total_ms.push_back(ms_since(t0));
         }
         const double t = median(total_ms);
         std::printf("%-20s %12.3f %12.3f %8.2f\n", c.name, median(apply_ms), t, t / frame_ms);
         rows.push_back({{"change", c.name}, {"apply_ms", median(apply_ms)}, {"to_first_frame_ms", t},
                         {"frames", t / frame_ms}});
+        ctx.wait_idle();
         r.apply(o);
     }
+    if (r.model_swaps() == 0) throw Error("no model swap happened");
     // For scale: what a rebuild (a new renderer: scene upload, pipelines) costs.
     const auto t0 = clock_type::now();
     {
@@ -170,7 +199,9 @@ int main(int argc, char** argv) try {
         nlohmann::json j = {{"device", ctx.features().device_name}, {"width", a.width}, {"height", a.height},
                             {"model", a.model}, {"scene", a.scene}, {"viewer_frame_ms", frame_ms},
                             {"render_ms_per_sample", render_ms}, {"render_gpu_ms_per_sample", rr.stats.gpu_ms / a.frames},
-                            {"viewer_over_render", frame_ms / render_ms}, {"rebuild_ms", rebuild_ms}, {"changes", rows}};
+                            {"viewer_over_render", frame_ms / render_ms}, {"rebuild_ms", rebuild_ms}, {"changes", rows},
+                            {"viewer_frame_blocking_ms", blocking_ms}, {"frames_in_flight", viewer::FRAMES_IN_FLIGHT},
+                            {"swap_model", a.swap_model.empty() ? a.model : a.swap_model}};
         std::ofstream(a.json) << j.dump(2) << "\n";
     }
     return 0;

@@ -3,7 +3,9 @@
 // the loss of every step; pause holds it between steps, stop ends it; bad starts are one-line errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <thread>
 
 #include "app/viewer/live_training.h"
@@ -62,7 +64,8 @@ TEST(LiveTraining, SnapshotsThenTheFinalModel) {
     EXPECT_EQ(s.snapshots, 4u); // after steps 10, 20, 30, and the final model
     ASSERT_EQ(s.loss_history.size(), 40u);
     EXPECT_GT(s.nodes, 1u);
-    const auto model = t.take_model();
+    std::shared_ptr<const std::vector<float>> loss;
+    const auto model = t.take_model(&loss);
     ASSERT_NE(model, nullptr);
     EXPECT_EQ(t.take_model(), nullptr); // taken once
     EXPECT_EQ(t.latest_model(), model);
@@ -70,6 +73,36 @@ TEST(LiveTraining, SnapshotsThenTheFinalModel) {
     EXPECT_EQ(model->assets[0].name, "ball");
     EXPECT_EQ(model->meta.steps, 40u);
     EXPECT_EQ(model->meta.source, "sphere");
+    // The per-node training loss: one value per model node; the leaves of the final cut trained (finite,
+    // positive), and they differ (the loss the split heuristic ranks by).
+    ASSERT_NE(loss, nullptr);
+    ASSERT_EQ(loss->size(), model->nodes.size());
+    const NbvhTree tree = model->tree();
+    std::vector<float> leaf_loss;
+    for (uint32_t n : tree.leaves_at(0)) {
+        ASSERT_TRUE(std::isfinite((*loss)[n])) << "leaf " << n;
+        EXPECT_GT((*loss)[n], 0.0f);
+        leaf_loss.push_back((*loss)[n]);
+    }
+    ASSERT_GT(leaf_loss.size(), 1u);
+    EXPECT_LT(*std::min_element(leaf_loss.begin(), leaf_loss.end()), *std::max_element(leaf_loss.begin(), leaf_loss.end()));
+}
+
+TEST(LiveTraining, NodeLossSumsPerBaseNode) {
+    NodeLossSums sums;
+    sums.add(3, 2.0, 4);
+    sums.add(3, 1.0, 2);
+    sums.add(1, 0.5, 1);
+    NeuralModel m;
+    m.nodes.resize(3);
+    m.nodes[0].base_node = 3;
+    m.nodes[1].base_node = 1;
+    m.nodes[2].base_node = 7; // never trained
+    const std::vector<float> l = sums.per_node(m);
+    ASSERT_EQ(l.size(), 3u);
+    EXPECT_FLOAT_EQ(l[0], 0.5f);
+    EXPECT_FLOAT_EQ(l[1], 0.5f);
+    EXPECT_TRUE(std::isnan(l[2]));
 }
 
 TEST(LiveTraining, PauseHoldsAndStopEnds) {

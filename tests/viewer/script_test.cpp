@@ -59,7 +59,7 @@ TEST(ViewerScript, ErrorsNameFileAndLine) {
     EXPECT_EQ(error_of("frames\n"), "s.txt:1: expected 'frames N'");
     EXPECT_EQ(error_of("set lod\n"), "s.txt:1: expected 'set KEY VALUE'");
     EXPECT_EQ(error_of("set colour red\n"), "s.txt:1: set: unknown setting 'colour'");
-    EXPECT_EQ(error_of("set view sideways\n"), "s.txt:1: set view 'sideways': expected image, split, difference or flip");
+    EXPECT_EQ(error_of("set view sideways\n"), "s.txt:1: set view 'sideways': expected image, split, difference, flip or loss");
     EXPECT_EQ(error_of("set split 1.5\n"), "s.txt:1: set split '1.5': expected a number in [0, 1]");
     EXPECT_EQ(error_of("set max_depth 3x\n"), "s.txt:1: set max_depth '3x': expected an integer in [1, 32]");
     EXPECT_EQ(error_of("set neural maybe\n"), "s.txt:1: set neural 'maybe': expected on or off");

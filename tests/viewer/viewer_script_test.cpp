@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "engine/core/image.h"
 #include "tests/cli/run_nbvh.h"
@@ -47,6 +48,20 @@ const fs::path& tiny_model() {
         const RunResult r =
             run_nbvh({"train", "default", "--backend", "cpu", "--steps", "20", "--batch", "256", "--nodes", "63",
                       "--hash-log2", "12", "--lods", "2", "--threads", "2", "--out", m.string()},
+                     120.0);
+        EXPECT_EQ(r.exit_code, 0) << r.describe();
+        return m;
+    }();
+    return model;
+}
+
+// Another model of the same scene and assets (more steps: other weights and cut), for model swaps.
+const fs::path& tiny_model_b() {
+    static const fs::path model = [] {
+        const fs::path m = tiny_model().parent_path() / "tiny_b.nbvh";
+        const RunResult r =
+            run_nbvh({"train", "default", "--backend", "cpu", "--steps", "40", "--batch", "256", "--nodes", "127",
+                      "--hash-log2", "12", "--lods", "2", "--threads", "2", "--seed", "7", "--out", m.string()},
                      120.0);
         EXPECT_EQ(r.exit_code, 0) << r.describe();
         return m;
@@ -120,6 +135,42 @@ TEST(ViewerSession, SliderChangesAreUploadsAndChangeTheImage) {
     const Image classical = load_image((dir / "classical.png").string());
     EXPECT_GT(mean_diff(lod0, lod1, 0, 160), 1e-4);     // the LoD slider changed the image
     EXPECT_GT(mean_diff(lod0, classical, 0, 160), 5e-3); // neural off shows the true scene
+}
+
+// A model of the same assets, dropped on the window, replaces the model as an upload: no renderer is
+// built, the image changes, the node counts follow the new model, and the split view's classical
+// reference keeps its film. The leaf budget is an upload too, and the stats count the rays it truncates.
+TEST(ViewerSession, ModelSwapIsAnUploadAndLeafCapHitsAreCounted) {
+    REQUIRE_XVFB();
+    const fs::path dir = test::temp_dir("viewer_session_swap");
+    const RunResult r = run_view(dir, "set max_spp 2\n"
+                                      "frames 3\nscreenshot a.png\nreport r0.json\n"
+                                      "drop " + tiny_model_b().string() + "\nframes 3\nscreenshot b.png\nreport r1.json\n"
+                                      "set view split\nframes 3\nreport r2.json\n"
+                                      "drop " + tiny_model().string() + "\nframes 1\nreport r3.json\n"
+                                      "set view image\nset max_leaves 1\nframes 1\nreport r4.json\n"
+                                      "set max_leaves 256\nframes 1\nreport r5.json\n",
+                                 {"--model", tiny_model().string()});
+    expect_clean(r);
+    const json r0 = read_json(dir / "r0.json"), r1 = read_json(dir / "r1.json"), r2 = read_json(dir / "r2.json");
+    const json r3 = read_json(dir / "r3.json"), r4 = read_json(dir / "r4.json"), r5 = read_json(dir / "r5.json");
+    EXPECT_EQ(r1["status"], "opened " + tiny_model_b().string());
+    EXPECT_EQ(r1["renderer_builds"], 1) << r1.dump(2);
+    EXPECT_EQ(r1["model_swaps"], 1);
+    EXPECT_NE(r1["lod_node_counts"], r0["lod_node_counts"]); // the new model's cut
+    EXPECT_EQ(r1["samples"], 2);
+    EXPECT_GT(mean_diff(load_image((dir / "a.png").string()), load_image((dir / "b.png").string()), 0, 160), 1e-3);
+    // Swapping back while the split view runs: the classical reference is neither rebuilt nor restarted.
+    EXPECT_EQ(r2["reference_samples"], 2);
+    EXPECT_EQ(r3["model_swaps"], 2);
+    EXPECT_EQ(r3["renderer_builds"], 1);
+    EXPECT_EQ(r3["reference_builds"], 1);
+    EXPECT_EQ(r3["reference_samples"], 2) << "the reference film restarted on a model swap";
+    // Leaf budget 1: rays that need a second leaf are truncated and counted; 256: none is.
+    EXPECT_EQ(r4["max_leaves"], 1);
+    EXPECT_GT(r4["main"]["neural"]["leaf_cap_rays"].get<uint64_t>(), 0u) << r4["main"].dump(2);
+    EXPECT_EQ(r5["main"]["neural"]["leaf_cap_rays"], 0);
+    EXPECT_EQ(r5["renderer_builds"], 1);
 }
 
 TEST(ViewerSession, SplitViewShowsBothHalves) {
@@ -245,7 +296,8 @@ TEST(ViewerSession, LiveCpuTrainingLowersTheLossAndChangesTheImage) {
                                       "set train_backend cpu\nset train_steps 60\nset train_nodes 63\n"
                                       "set train_batch 512\nset train_hash_log2 12\nset train_threads 1\n"
                                       "set train_snapshot 20\ntrain start\ntrain wait 400\n"
-                                      "frames 3\nscreenshot after.png\nreport r1.json\ntrain save live.nbvh\n",
+                                      "frames 3\nscreenshot after.png\nreport r1.json\ntrain save live.nbvh\n"
+                                      "set view loss\nframes 2\nscreenshot loss.png\nreport r2.json\n",
                                  {}, 600.0);
     expect_clean(r);
     const json r0 = read_json(dir / "r0.json"), t = read_json(dir / "r1.json");
@@ -260,9 +312,31 @@ TEST(ViewerSession, LiveCpuTrainingLowersTheLossAndChangesTheImage) {
     for (size_t i = 0; i < 10; ++i) first += loss[i], last += loss[loss.size() - 1 - i];
     EXPECT_LT(last, 0.9 * first) << "mean loss of the first 10 steps " << first / 10 << ", last 10 " << last / 10;
     EXPECT_EQ(t["has_model"], true);
-    EXPECT_GE(t["renderer_builds"].get<int>(), 2); // a new model is a new renderer (apply cannot swap models)
+    // The first snapshot binds the scene to a model (a build); the next ones are uploads (one or two: the
+    // final model may replace the step-40 snapshot before a frame takes it).
+    EXPECT_EQ(t["renderer_builds"], 2) << t.dump(2);
+    EXPECT_GE(t["model_swaps"].get<int>(), 1) << t.dump(2);
     const Image before = load_image((dir / "before.png").string()), after = load_image((dir / "after.png").string());
     EXPECT_GT(mean_diff(before, after, 0, 160), 1e-3);
+    // The loss view of the trained model: the knot's leaves in several colours (their losses differ).
+    const json l = read_json(dir / "r2.json");
+    EXPECT_EQ(l["view"], "loss");
+    EXPECT_EQ(l["loss_view"]["available"], true);
+    EXPECT_GE(l["loss_view"]["leaves"].get<int>(), 4) << l.dump(2);
+    EXPECT_LT(l["loss_view"]["lo"].get<double>(), 0.8 * l["loss_view"]["hi"].get<double>()) << l.dump(2);
+    EXPECT_EQ(l["renderer_builds"], 2); // no reference renderer, no rebuild
+    const Image loss_png = load_image((dir / "loss.png").string());
+    std::set<uint32_t> colours;
+    size_t coloured = 0;
+    for (size_t i = 0; i < loss_png.pixel_count(); ++i) {
+        const float* p = loss_png.data.data() + i * loss_png.channels;
+        if (std::fabs(p[0] - p[1]) + std::fabs(p[1] - p[2]) < 0.05f) continue; // grey: triangles, misses
+        ++coloured;
+        colours.insert(uint32_t(p[0] * 15.0f + 0.5f) | uint32_t(p[1] * 15.0f + 0.5f) << 4 |
+                       uint32_t(p[2] * 15.0f + 0.5f) << 8);
+    }
+    EXPECT_GT(coloured, 100u);
+    EXPECT_GE(colours.size(), 6u) << "the loss view is (nearly) uniform";
     ASSERT_TRUE(fs::exists(dir / "live.nbvh"));
     const RunResult info = run_nbvh({"info", (dir / "live.nbvh").string()}, 30.0);
     EXPECT_EQ(info.exit_code, 0) << info.describe();

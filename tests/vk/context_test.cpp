@@ -182,6 +182,43 @@ TEST(VkCommands, IndirectDispatchAndTimers) {
     EXPECT_EQ(ctx.validation_message_count(), 0);
 }
 
+// What a presenter's frames in flight use: two command buffers ordered by a semaphore (the second
+// waits for the first on the GPU, only its own fence is waited for), column ranges of two buffers
+// copied into one image, and a layout transition of an image the layer does not own.
+TEST(VkCommands, SemaphoreOrderedSubmissionsAndImageCopies) {
+    Context ctx = make_cpu_context();
+    const uint32_t w = 6, h = 3;
+    std::vector<uint32_t> left(w * h), right(w * h);
+    for (uint32_t i = 0; i < w * h; ++i) left[i] = 0x01000000u + i, right[i] = 0x02000000u + i;
+    Buffer a = make_buffer(ctx, left, "left"), b(ctx, w * h * 4, MemoryKind::device, 0, "right");
+    Buffer staging = make_buffer(ctx, right, "right staging");
+    Image film(ctx, w, h, ImageFormat::rgba8, image_sampled, "film");
+    Semaphore ready(ctx, "right ready");
+    CommandBuffer first(ctx, "first"), second(ctx, "second");
+    first.begin().copy(staging, b, w * h * 4).submit({.signal = ready.handle()});
+    second.begin()
+        .copy_to_image(a, 0, w, film, 0, 0, 2, h)      // columns [0, 2) from `left`
+        .copy_to_image(b, 2 * 4, w, film, 2, 0, w - 2, h) // columns [2, w) from `right`
+        .barrier(Barrier::transfer_to_transfer);
+    second.submit({.wait = ready.handle(), .wait_stage = VK_PIPELINE_STAGE_TRANSFER_BIT});
+    EXPECT_TRUE(second.in_flight());
+    second.wait();
+    EXPECT_FALSE(second.in_flight());
+    std::vector<uint32_t> back(w * h);
+    film.download(back.data(), back.size() * 4);
+    for (uint32_t y = 0; y < h; ++y)
+        for (uint32_t x = 0; x < w; ++x) EXPECT_EQ(back[y * w + x], (x < 2 ? left : right)[y * w + x]) << x << "," << y;
+    // A transition through TRANSFER_DST and back (what the presenter does to swapchain images).
+    second.begin()
+        .transition(film.handle(), VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                    VK_PIPELINE_STAGE_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT)
+        .transition(film.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
+                    VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                    VK_ACCESS_TRANSFER_READ_BIT)
+        .submit_and_wait();
+    EXPECT_EQ(ctx.validation_message_count(), 0);
+}
+
 // The messenger counts what the layer reports (so the "zero messages" checks everywhere can fail):
 // a fill whose size is not a multiple of 4 is a validation error (recorded, never submitted).
 TEST(VkContext, ValidationMessagesAreCounted) {
