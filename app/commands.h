@@ -13,6 +13,7 @@ void add_flip_command(CLI::App& app);
 void add_info_command(CLI::App& app);
 // `command_line`: the whole command as typed (written into the benchmark results).
 void add_bench_command(CLI::App& app, const std::string& command_line);
+void add_bench_features_command(CLI::App& app, const std::string& command_line);
 void add_study_command(CLI::App& app, const std::string& command_line);
 void add_view_command(CLI::App& app);
 

@@ -1,4 +1,4 @@
-// nbvh: neural BVH renderer. Subcommands: render, train, flip, info, bench, study, view.
+// nbvh: neural BVH renderer. Subcommands: render, train, flip, info, bench, bench-features, study, view.
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     nbvh::app::add_info_command(app);
     const std::string command = nbvh::app::command_line(argc, argv);
     nbvh::app::add_bench_command(app, command);
+    nbvh::app::add_bench_features_command(app, command);
     nbvh::app::add_study_command(app, command);
     nbvh::app::add_view_command(app);
     try {
