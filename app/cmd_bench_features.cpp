@@ -201,6 +201,8 @@ std::string markdown_table(const nlohmann::json& scenes) {
     return s;
 }
 
+void write_results(const Args& a, const std::string& device, const std::string& driver, const nlohmann::json& scenes);
+
 void run_bench_features(const Args& a) {
     check_output_path(a.json, "--json", a.scenes);
     check_output_path(a.markdown, "--markdown", a.scenes);
@@ -208,14 +210,21 @@ void run_bench_features(const Args& a) {
     vk::ContextOptions copt;
     copt.device = vk::parse_device_choice(a.device);
     vk::Context ctx(copt);
-    nlohmann::json scenes = nlohmann::json::array();
-    bool agree = true;
-    for (const std::string& scene : a.scenes) scenes.push_back(bench_scene(ctx, a, scene, agree));
     const std::string device = ctx.features().device_name;
     const std::string driver = ctx.features().driver_name + " " + ctx.features().driver_info;
     std::printf("device %s (driver %s), %ux%u, %u spp, max depth %u, median of %u frames after a warm-up\n",
                 device.c_str(), driver.c_str(), a.options.width, a.options.height, a.options.spp, a.options.max_depth,
                 a.repeat);
+    nlohmann::json scenes = nlohmann::json::array();
+    bool agree = true;
+    for (const std::string& scene : a.scenes) {
+        scenes.push_back(bench_scene(ctx, a, scene, agree));
+        write_results(a, device, driver, scenes); // after every scene: a run cut short keeps what it measured
+    }
+    if (!agree) throw Error("the all-forced image differs from the own one (see FLIP own/all): a forcing is wrong");
+}
+
+void write_results(const Args& a, const std::string& device, const std::string& driver, const nlohmann::json& scenes) {
     if (!a.json.empty()) {
         const nlohmann::json j = {{"device", device}, {"driver", driver}, {"commit", build_commit()},
                                   {"command_line", a.command_line}, {"width", a.options.width},
@@ -231,7 +240,6 @@ void run_bench_features(const Args& a) {
                                                  device.c_str(), driver.c_str(), build_commit(), a.options.width,
                                                  a.options.height, a.options.spp, a.options.max_depth, a.repeat) +
                                               markdown_table(scenes));
-    if (!agree) throw Error("the all-forced image differs from the own one (see FLIP own/all): a forcing is wrong");
 }
 
 } // namespace
