@@ -317,3 +317,51 @@ TEST(MultiAsset, SettingsApplyWithoutRebuildMatchFreshRenderers) {
     EXPECT_EQ(live.live_updates(), 3u);
     EXPECT_EQ(ctx.validation_message_count(), 0);
 }
+
+// Another model of the same assets is an upload too (the viewer's model swaps: live-training snapshots,
+// a retrained file): after apply() the renderer renders exactly what a fresh renderer with that model
+// renders, its neural instances marked for the new model's atlas transforms. A model that does not
+// answer the scene is an error that changes nothing.
+TEST(MultiAsset, ModelSwapMatchesAFreshRenderer) {
+    const Trained& t = trained();
+    Scene scene = make_scene();
+    bind_model_to_scene(scene, t.model, "m.nbvh");
+    vk::Context ctx(lavapipe());
+    const SceneAccel accel = build_scene_accel(scene);
+    // Same assets, other numbers: the grid permuted and every asset's atlas offset moved.
+    NeuralModel other = t.model;
+    for (size_t i = 0; i < other.grid.size(); ++i) other.grid[i] = t.model.grid[(i * 7919 + 13) % t.model.grid.size()];
+    for (ModelAsset& a : other.assets) a.offset += glm::vec3(0.02f, -0.01f, 0.015f) * a.scale;
+    NeuralModel stranger = t.model; // an asset the scene does not have
+    stranger.assets[0].name += "_renamed";
+    RenderOptions o;
+    o.width = o.height = 48;
+    o.spp = 2;
+    o.max_depth = 3;
+    o.seed = 9;
+    o.neural.path = NeuralPath::scalar;
+    o.neural.model = &t.model;
+    RenderOptions swapped = o;
+    swapped.neural.model = &other;
+    swapped.neural.lod = 0;
+    auto fresh = [&](const RenderOptions& opt) {
+        WavefrontRenderer r(ctx, scene, accel, default_sky(), scene.camera, opt);
+        return r.render().image;
+    };
+    WavefrontRenderer live(ctx, scene, accel, default_sky(), scene.camera, o);
+    const Image a = live.render().image;
+    ASSERT_TRUE(live.apply(swapped));
+    EXPECT_EQ(live.model_swaps(), 1u);
+    const Image b = live.render().image;
+    EXPECT_EQ(b.data, fresh(swapped).data);
+    EXPECT_NE(b.data, a.data); // the swap changed what is rendered (control)
+    RenderOptions bad = o;
+    bad.neural.model = &stranger;
+    EXPECT_THROW(live.apply(bad), Error);
+    EXPECT_EQ(live.model_swaps(), 1u);
+    EXPECT_EQ(live.render().image.data, b.data); // still the swapped model, unchanged
+    ASSERT_TRUE(live.apply(o));                  // and back
+    EXPECT_EQ(live.render().image.data, a.data);
+    EXPECT_EQ(live.model_swaps(), 2u);
+    EXPECT_EQ(ctx.validation_message_count(), 0);
+}
