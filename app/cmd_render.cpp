@@ -4,6 +4,7 @@
 //                   [--model M.nbvh [--lod L] [--secondary-lod L] [--neural-path auto|scalar|coopmat]]
 //                   [--classical] [--neural GLOB] [--neural-roughness R] [--neural-metallic M]
 //                   [--neural-max-leaves N] [--neural-batched-rounds N] [--wave-pixels N]
+//                   [--texture-path auto|buffer|array]
 // With --model the scene's neural instances are rendered from the model (hybrid); --classical renders
 // them from their triangles with the same material constants (the reference FLIP compares against).
 // Loads the scene, builds its BVHs, runs the wavefront path tracer (engine/render/) and writes the image
@@ -40,7 +41,7 @@ namespace {
 struct RenderArgs {
     std::string scene, out = "render.png", device = "auto", camera, env, stats, exposure = "auto";
     std::optional<float> env_rotation; // degrees
-    std::string model, neural_path = "auto", neural_glob;
+    std::string model, neural_path = "auto", neural_glob, texture_path = "auto";
     render::RenderOptions options;
     bool explain = false;
 };
@@ -71,6 +72,8 @@ void write_stats(const std::string& path, const render::RenderStats& s, const st
     j["rays_per_second"] = s.rays_per_second();
     j["non_finite_samples"] = s.nonfinite_samples;
     j["non_finite_pixels"] = s.nonfinite_pixels;
+    j["textures"] = {{"path", s.texture_path}, {"count", s.texture_count}, {"gpu_bytes", s.texture_bytes},
+                     {"halvings", s.texture_halvings}};
     j["exposure"] = {{"mode", exposure.mode}, {"stops", exposure.stops}};
     if (!s.neural_path.empty()) {
         nlohmann::json n;
@@ -94,6 +97,7 @@ void run_render(const RenderArgs& a) {
     check_output_path(a.out, "--out", inputs);
     check_output_path(a.stats, "--stats", inputs);
     const std::optional<float> fixed_exposure = parse_exposure(a.exposure);
+    const render::TexturePathRequest texture_path = render::parse_texture_path(a.texture_path);
     if (fixed_exposure && is_exr_path(a.out))
         log_warn("render: --exposure is ignored for EXR output (linear radiance, unscaled)");
     vk::ContextOptions copt;
@@ -101,6 +105,7 @@ void run_render(const RenderArgs& a) {
     SceneLoadOptions lo;
     lo.neural_glob = a.neural_glob;
     render::RenderOptions options = a.options;
+    options.texture_path = texture_path;
     NeuralModel model;
     if (!a.model.empty()) model = load_model(a.model);
     // With a model (also for --classical: the same instances, from their triangles) its asset table
@@ -112,12 +117,18 @@ void run_render(const RenderArgs& a) {
     if (a.env_rotation) env.rotation = *a.env_rotation * 3.14159265358979f / 180.0f;
     const Camera camera = choose_camera(scene, a.camera, a.options);
     if (a.explain) {
-        // A hybrid render's neural stage is built on the device, as the renderer builds it (its kernel).
+        // A hybrid render's neural stage and the texture path are chosen on the device, as the renderer
+        // chooses them.
+        const render::SceneFeatures features = render::derive_features(scene, env, options.neural);
         std::optional<vk::Context> ectx;
-        if (options.neural.model) ectx.emplace(copt);
+        if (options.neural.model || features.textures) ectx.emplace(copt);
         const auto plan = render::plan_neural(ectx ? &*ectx : nullptr, scene, options.neural);
-        std::printf("%s", render::explain(render::derive_features(scene, env, options.neural), options.max_depth,
-                                          plan ? &*plan : nullptr).c_str());
+        std::optional<render::TexturePlan> textures;
+        if (ectx)
+            textures = render::plan_textures(render::texture_caps(ectx->features()), scene, features.textures,
+                                             options.texture_path);
+        std::printf("%s", render::explain(features, options.max_depth, plan ? &*plan : nullptr,
+                                          textures ? &*textures : nullptr).c_str());
         return;
     }
     vk::Context ctx(copt); // before the BVH build: a missing device fails fast
@@ -130,6 +141,8 @@ void run_render(const RenderArgs& a) {
     const render::RenderStats& s = result.stats;
     log_info("render: %ux%u, %u spp on %s: %.1f ms GPU, %.3g rays/s, %llu non-finite pixels", s.width, s.height,
              s.spp, s.device.c_str(), s.gpu_ms, s.rays_per_second(), (unsigned long long)s.nonfinite_pixels);
+    if (s.texture_path != "none")
+        log_info("render: textures: %s", render::describe(renderer.texture_plan()).c_str());
     if (!s.neural_path.empty())
         log_info("render: neural %s: %llu queries (%.2f per ray), %.3g queries/s over %.2f ms of query passes; "
                  "%llu rays truncated by the leaf budget (--neural-max-leaves)",
@@ -185,6 +198,9 @@ void add_render_command(CLI::App& app) {
     cmd->add_option("--secondary-lod", args->options.neural.secondary_lod,
                     "N-BVH level of detail after the first hit (default: --lod)");
     cmd->add_option("--neural-path", args->neural_path, "MLP implementation: auto, scalar or coopmat");
+    cmd->add_option("--texture-path", args->texture_path,
+                    "textures as one texel buffer (any device), an array of images (descriptor indexing), or "
+                    "auto (default): the array where the device has it; --explain and --stats say which ran");
     cmd->callback([args] { run_render(*args); });
 }
 

@@ -161,12 +161,13 @@ std::vector<std::string> pass_list(const SceneFeatures& f, const NeuralPlan* neu
     return passes;
 }
 
-std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan* neural) {
+std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan* neural, const TexturePlan* textures) {
     const NeuralPlan* n = f.neural ? neural : nullptr;
     auto yn = [](bool b) { return b ? "yes" : "no"; };
     std::string s;
     s += "scene features:\n";
     s += strfmt("  textures        %s%s\n", yn(f.textures), f.textures ? "" : "  (no texture fetches)");
+    if (f.textures && textures) s += "    path          " + describe(*textures) + "\n";
     s += strfmt("  normal maps     %s\n", yn(f.normal_maps));
     s += strfmt("  emission        %s%s\n", yn(f.emission), f.emission ? "  (emissive-triangle NEE + MIS)" : "");
     s += strfmt("  environment     %s%s\n", yn(f.environment),

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "engine/render/neural_stage.h"
+#include "engine/render/texture_path.h"
 #include "engine/scene/scene.h"
 #include "engine/vk/context.h"
 #include "engine/vk/pipeline.h"
@@ -83,7 +84,9 @@ std::vector<vk::SpecConstant> specialization(const SceneFeatures& features);
 // one bounce listed. Hybrid renders (`neural`) traverse through the neural rounds (neural_stage.h).
 std::vector<std::string> pass_list(const SceneFeatures& features, const NeuralPlan* neural = nullptr);
 
-// Multi-line description for `nbvh render --explain`: the features, the neural stage, the passes.
-std::string explain(const SceneFeatures& features, uint32_t max_depth, const NeuralPlan* neural = nullptr);
+// Multi-line description for `nbvh render --explain`: the features (with `textures`: the texture path
+// and its memory), the neural stage, the passes.
+std::string explain(const SceneFeatures& features, uint32_t max_depth, const NeuralPlan* neural = nullptr,
+                    const TexturePlan* textures = nullptr);
 
 } // namespace nbvh::render

@@ -5,6 +5,7 @@
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
+#include "engine/render/texture_path.h"
 #include "engine/scene/outline_shells.h"
 #include "shaders/shared/sampling.h"
 
@@ -75,35 +76,23 @@ void pack_textures(const Scene& scene, const PackOptions& options, GpuSceneData&
         out.texels.assign(1, 0xFFFFFFFFu);
         return;
     }
-    std::vector<Texture> textures;
-    textures.reserve(scene.textures.size());
-    uint64_t total = 0;
-    for (const Texture& t : scene.textures) {
-        const bool valid = t.width > 0 && t.height > 0 && t.rgba8.size() >= size_t(t.width) * t.height * 4;
-        Texture copy;
-        if (valid) copy = t;
-        else { copy.width = copy.height = 1; copy.rgba8 = {255, 255, 255, 255}; }
-        total += uint64_t(copy.width) * copy.height * 4;
-        textures.push_back(std::move(copy));
-    }
-    // Halve the largest textures until everything fits one storage binding.
-    while (total > options.texel_budget_bytes) {
-        size_t largest = 0;
-        for (size_t i = 1; i < textures.size(); ++i)
-            if (textures[i].rgba8.size() > textures[largest].rgba8.size()) largest = i;
-        if (textures[largest].width <= 1 && textures[largest].height <= 1) break;
-        total -= textures[largest].rgba8.size();
-        textures[largest] = halve(textures[largest]);
-        total += textures[largest].rgba8.size();
-        ++out.texture_downscales;
-    }
+    // Halve the largest textures until everything fits one storage binding (texture_path.h).
+    const TexelBufferPlan plan = plan_texel_buffer(scene.textures, options.texel_budget_bytes);
+    out.texture_downscales = plan.total_halvings;
     if (out.texture_downscales > 0)
         log_info("render: %u texture halvings to fit %llu MiB of texels", out.texture_downscales,
                  (unsigned long long)(options.texel_budget_bytes >> 20));
     out.texels.clear();
-    out.texels.reserve(total / 4);
-    for (size_t i = 0; i < textures.size(); ++i) {
-        const Texture& t = textures[i];
+    out.texels.reserve(plan.bytes / 4);
+    for (size_t i = 0; i < scene.textures.size(); ++i) {
+        Texture t;
+        if (texture_valid(scene.textures[i])) {
+            t = scene.textures[i];
+            for (uint32_t k = 0; k < plan.halvings[i]; ++k) t = halve(t);
+        } else {
+            t.width = t.height = 1;
+            t.rgba8 = {255, 255, 255, 255};
+        }
         out.texture_infos[i] = GpuTextureInfo{uint32_t(out.texels.size()), t.width, t.height, 0};
         for (size_t p = 0; p < size_t(t.width) * t.height; ++p) {
             const uint8_t* c = &t.rgba8[p * 4];

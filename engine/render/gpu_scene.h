@@ -21,7 +21,7 @@ struct GpuSceneData {
     std::vector<GpuVertex> vertices;      // all meshes' vertices, concatenated
     std::vector<GpuMaterial> materials;
     std::vector<GpuTextureInfo> texture_infos;
-    std::vector<uint32_t> texels;         // RGBA8
+    std::vector<uint32_t> texels;         // RGBA8 (buffer texture path; a placeholder word otherwise)
     std::vector<GpuLight> lights;         // emissive triangles, then punctual lights, world space
     std::vector<float> light_cdf;         // emissive_light_count + 1 entries, then punctual_light_count + 1
     float light_total_power = 0.0f;       // of the emissive triangles
@@ -38,8 +38,9 @@ struct GpuSceneData {
 };
 
 struct PackOptions {
-    bool textures = true;                       // false: no texel upload (scene has no texture feature)
-    uint64_t texel_budget_bytes = 96ull << 20;  // below lavapipe's 128 MiB per binding
+    // false: no texel upload (the scene fetches no texel, or the texture-array path holds them as images)
+    bool textures = true;
+    uint64_t texel_budget_bytes = 96ull << 20;  // below lavapipe's 128 MiB per binding (texture_path.h)
 };
 
 // `environment` is the one the render uses (scene's, --env, or the default sky).

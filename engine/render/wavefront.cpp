@@ -7,6 +7,7 @@
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/scene/camera.h"
+#include "shaders/shader_registry.h"
 #include "shaders/shared/intersect.h"
 #include "shaders/shared/wavefront_gpu.h"
 
@@ -74,13 +75,19 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     capacity_ = uint32_t(cap);
 
     features_ = derive_features(scene, environment);
+    // Textures: one texel buffer, or one image each in a sampled-image array (texture_path.h).
+    texture_plan_ = plan_textures(texture_caps(dev), scene, features_.textures, options_.texture_path);
+    const bool texture_array = texture_plan_.path == TexturePath::array;
     PackOptions pack;
-    pack.textures = features_.textures;
-    // All texels live in one storage buffer (a sampled-image array would need descriptor indexing,
-    // which Debian 12's lavapipe lacks): up to 3/4 of the device's storage-buffer range, at most 1 GiB
-    // (lavapipe: 96 of 128 MiB; NVIDIA: 1 GiB, so large scenes keep their full-size textures).
-    pack.texel_budget_bytes = std::clamp<uint64_t>(range / 4 * 3, 96ull << 20, 1ull << 30);
+    pack.textures = texture_plan_.path == TexturePath::buffer;
+    pack.texel_budget_bytes = texel_budget_bytes(range);
     data_ = pack_scene(scene, accel, environment, pack);
+    if (texture_array) {
+        texture_array_ = TextureArray(ctx_, scene.textures);
+        texture_plan_.bytes = texture_array_.bytes();
+    } else if (texture_plan_.path == TexturePath::buffer) {
+        texture_plan_.bytes = uint64_t(data_.texels.size()) * 4;
+    }
     // Neural instances: N-BVH + network (hybrid), or triangles with the neural material constants
     // (classical reference); without either they render as plain triangles.
     const NeuralRenderOptions& nopt = options_.neural;
@@ -160,8 +167,12 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
         buffers_[b].fill(0u);
 
     // One pipeline per pass, all with the same set-0 layout and the scene's specialization.
+    // The texture-array path: binding NB_BIND_TEXELS is the image array, the passes their variants.
     std::vector<vk::Binding> bindings;
-    for (uint32_t b = 0; b < NB_NEURAL_BINDING_END; ++b) bindings.push_back({b, vk::BindingType::storage_buffer, 1});
+    for (uint32_t b = 0; b < NB_NEURAL_BINDING_END; ++b)
+        bindings.push_back(texture_array && b == NB_BIND_TEXELS
+                               ? vk::Binding{b, vk::BindingType::combined_image_sampler, texture_array_.size()}
+                               : vk::Binding{b, vk::BindingType::storage_buffer, 1});
     const std::vector<vk::SpecConstant> spec = specialization(features_);
     for (size_t i = 0; i < PASS_COUNT; ++i) {
         if (((i == SHADOW || i == NEURAL_SHADOW) && !features_.has_lights()) || (i >= NEURAL_TRAVERSE && !neural_)) {
@@ -171,12 +182,15 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
         }
         vk::PipelineDesc desc;
         desc.shader = i == NEURAL_QUERY ? neural_->query_shader() : PASS_SHADERS[i];
+        if (texture_array) desc.shader = shaders::variant(desc.shader, "texture_array");
         desc.bindings = bindings;
         desc.spec = spec;
         desc.push_constant_bytes = sizeof(GpuPassConstants);
         pipelines_.emplace_back(ctx_, desc);
         vk::DescriptorSet set(ctx_, pipelines_.back());
-        for (uint32_t b = 0; b < NB_NEURAL_BINDING_END; ++b) set.bind(b, buffers_[b]);
+        for (uint32_t b = 0; b < NB_NEURAL_BINDING_END; ++b)
+            if (!(texture_array && b == NB_BIND_TEXELS)) set.bind(b, buffers_[b]);
+        if (texture_array) texture_array_.bind(set, NB_BIND_TEXELS);
         sets_.push_back(std::move(set));
     }
     make_timer();
@@ -425,6 +439,10 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
     s.rays_secondary = totals[1];
     s.rays_shadow = totals[2];
     s.nonfinite_samples = totals[3];
+    s.texture_path = texture_path_name(texture_plan_.path);
+    s.texture_count = texture_plan_.textures;
+    s.texture_bytes = texture_plan_.bytes;
+    s.texture_halvings = data_.texture_downscales;
     if (hybrid_) {
         s.neural_path = neural_->kernel().describe();
         s.neural_queries = totals[4];

@@ -15,6 +15,8 @@
 #include "engine/render/feature_set.h"
 #include "engine/render/gpu_scene.h"
 #include "engine/render/neural_stage.h"
+#include "engine/render/texture_array.h"
+#include "engine/render/texture_path.h"
 #include "shaders/shared/wavefront_gpu.h"
 #include "engine/scene/scene.h"
 #include "engine/vk/buffer.h"
@@ -35,6 +37,8 @@ struct RenderOptions {
     // the 1080p classical frame ~1.5x slower than one (results/neural/README.md, v12 vs v13).
     uint32_t max_wave_pixels = 1u << 22;
     NeuralRenderOptions neural;      // hybrid (model) or classical-reference render of neural instances
+    // Texel buffer or sampled-image array (texture_path.h): auto takes the array where the device can.
+    TexturePathRequest texture_path = TexturePathRequest::automatic;
     // Effects simulated although the scene lacks them (feature_set.h with_forced: same image, more
     // work); benchmarks only. The texture path is still chosen from the scene's own features.
     SceneFeatures forced_features;
@@ -49,6 +53,11 @@ struct RenderStats {
     uint64_t rays_primary = 0, rays_secondary = 0, rays_shadow = 0;
     uint64_t nonfinite_samples = 0; // dropped by accumulate.comp
     uint64_t nonfinite_pixels = 0;  // in the resolved image (counted on the CPU; must be 0)
+    // Textures (texture_path.h): the path that ran, its textures and their GPU bytes (buffer: the texel
+    // buffer; array: the images' allocations), halvings to fit the buffer's budget.
+    std::string texture_path;
+    uint32_t texture_count = 0, texture_halvings = 0;
+    uint64_t texture_bytes = 0;
     // Neural (hybrid renders): queries of path rays, rounds with queued pairs, the MLP path, and the
     // GPU time of the neural query passes (queries/s = neural_queries / neural_query_ms).
     std::string neural_path;
@@ -89,6 +98,7 @@ public:
 
     const SceneFeatures& features() const { return features_; }
     const GpuSceneData& scene_data() const { return data_; }
+    const TexturePlan& texture_plan() const { return texture_plan_; } // bytes: as allocated
 
     // Renders options.spp samples per pixel and reads the mean radiance back.
     RenderResult render();
@@ -146,7 +156,9 @@ private:
     const SceneAccel* accel_ = nullptr; // the caller's too (instance transforms for a model swap)
     RenderOptions options_;
     SceneFeatures features_;
+    TexturePlan texture_plan_;
     GpuSceneData data_;
+    TextureArray texture_array_; // the texture-array path's images (texture_plan_.path == array)
     GpuFrameParams params_{};
     uint32_t capacity_ = 0;
     uint32_t accumulated_ = 0; // samples per pixel in the film (progressive rendering)

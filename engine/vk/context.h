@@ -84,6 +84,9 @@ struct DeviceFeatures {
     bool buffer_device_address = false;
     bool memory_model = false;   // vulkanMemoryModel
     bool descriptor_partially_bound = false; // texture arrays may leave slots unwritten
+    // Descriptor indexing (core 1.2) for arrays of sampled images (engine/render/texture_path.h):
+    bool runtime_descriptor_array = false;          // runtimeDescriptorArray
+    bool sampled_image_array_nonuniform = false;    // shaderSampledImageArrayNonUniformIndexing
     bool subgroup_size_control = false;
     bool coop_matrix_nv = false; // VK_NV_cooperative_matrix
     std::vector<CoopMatrixShape> coop_matrix_shapes;
@@ -99,6 +102,12 @@ struct DeviceFeatures {
     uint32_t max_push_constants = 0;         // bytes
     uint32_t max_workgroup_invocations = 0;
     uint32_t max_workgroup_count[3] = {0, 0, 0};
+    // Combined image samplers one compute pipeline may see (the smallest of the per-stage and per-set
+    // sampler and sampled-image limits), resources per stage, the largest 2D image edge, allocations.
+    uint32_t max_sampled_images = 0;
+    uint32_t max_per_stage_resources = 0;
+    uint32_t max_image_dimension_2d = 0;
+    uint32_t max_memory_allocations = 0;     // maxMemoryAllocationCount
     float timestamp_period = 0.0f;           // nanoseconds per timestamp tick
     uint32_t timestamp_valid_bits = 0;       // of the compute queue; 0 = no timestamps
 

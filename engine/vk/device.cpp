@@ -82,6 +82,9 @@ std::string DeviceFeatures::summary() const {
                 yn(fp16), yn(int8), yn(int16), yn(int64), yn(storage16), yn(storage8), yn(scalar_layout));
     s += strfmt("  buffer device address %s, memory model %s, partially bound descriptors %s\n",
                 yn(buffer_device_address), yn(memory_model), yn(descriptor_partially_bound));
+    s += strfmt("  runtime descriptor arrays %s, non-uniform sampled-image indexing %s, %u sampled images per "
+                "pipeline, 2D images up to %u\n", yn(runtime_descriptor_array), yn(sampled_image_array_nonuniform),
+                max_sampled_images, max_image_dimension_2d);
     s += strfmt("  subgroup size %u (min %u, max %u, control %s), shared memory %u B, storage range %llu B\n",
                 subgroup_size, min_subgroup_size, max_subgroup_size, yn(subgroup_size_control),
                 max_shared_memory, (unsigned long long)max_storage_buffer_range);
@@ -187,6 +190,8 @@ void Context::create_device(const std::vector<std::string>& extra_extensions) {
     d.memory_model = f12.vulkanMemoryModel;
     d.descriptor_partially_bound = f12.descriptorBindingPartiallyBound && f12.runtimeDescriptorArray &&
                                    f12.shaderSampledImageArrayNonUniformIndexing;
+    d.runtime_descriptor_array = f12.runtimeDescriptorArray;
+    d.sampled_image_array_nonuniform = f12.shaderSampledImageArrayNonUniformIndexing;
     d.subgroup_size_control = has_ssc && ssc.subgroupSizeControl && ssc.computeFullSubgroups;
     d.coop_matrix_nv = has_coop && coop.cooperativeMatrix && d.fp16;
     d.pipeline_statistics = has_pep && pep.pipelineExecutableInfo;
@@ -201,6 +206,12 @@ void Context::create_device(const std::vector<std::string>& extra_extensions) {
     d.max_push_constants = props.limits.maxPushConstantsSize;
     d.max_workgroup_invocations = props.limits.maxComputeWorkGroupInvocations;
     for (int i = 0; i < 3; ++i) d.max_workgroup_count[i] = props.limits.maxComputeWorkGroupCount[i];
+    const VkPhysicalDeviceLimits& lim = props.limits;
+    d.max_sampled_images = std::min({lim.maxPerStageDescriptorSamplers, lim.maxPerStageDescriptorSampledImages,
+                                     lim.maxDescriptorSetSamplers, lim.maxDescriptorSetSampledImages});
+    d.max_per_stage_resources = lim.maxPerStageResources;
+    d.max_image_dimension_2d = lim.maxImageDimension2D;
+    d.max_memory_allocations = lim.maxMemoryAllocationCount;
     d.timestamp_period = props.limits.timestampPeriod;
     queue_family_ = compute_family(physical_, &d.timestamp_valid_bits);
 
@@ -239,8 +250,8 @@ void Context::create_device(const std::vector<std::string>& extra_extensions) {
     e12.hostQueryReset = f12.hostQueryReset;
     e12.descriptorIndexing = f12.descriptorIndexing;
     e12.descriptorBindingPartiallyBound = d.descriptor_partially_bound;
-    e12.runtimeDescriptorArray = d.descriptor_partially_bound;
-    e12.shaderSampledImageArrayNonUniformIndexing = d.descriptor_partially_bound;
+    e12.runtimeDescriptorArray = d.runtime_descriptor_array;
+    e12.shaderSampledImageArrayNonUniformIndexing = d.sampled_image_array_nonuniform;
     e12.shaderStorageBufferArrayNonUniformIndexing = f12.shaderStorageBufferArrayNonUniformIndexing;
     std::vector<const char*> enabled;
     void** etail = &e12.pNext;

@@ -75,6 +75,7 @@ Image::Image(const Context& ctx, uint32_t width, uint32_t height, ImageFormat fo
     vkGetImageMemoryRequirements(ctx.device(), image_, &req);
     VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     alloc.allocationSize = req.size;
+    memory_bytes_ = req.size;
     alloc.memoryTypeIndex = ctx.find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
     VkResult r = vkAllocateMemory(ctx.device(), &alloc, nullptr, &memory_);
     if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY) {
@@ -113,6 +114,7 @@ Image& Image::operator=(Image&& o) noexcept {
         height_ = o.height_;
         format_ = o.format_;
         usage_ = o.usage_;
+        memory_bytes_ = o.memory_bytes_;
         name_ = std::move(o.name_);
     }
     return *this;

@@ -44,6 +44,7 @@ public:
     ImageFormat format() const { return format_; }
     uint32_t usage() const { return usage_; }
     const std::string& name() const { return name_; }
+    uint64_t memory_bytes() const { return memory_bytes_; } // size of its allocation
     explicit operator bool() const { return image_ != VK_NULL_HANDLE; }
 
 private:
@@ -56,6 +57,7 @@ private:
     uint32_t width_ = 0, height_ = 0;
     ImageFormat format_ = ImageFormat::rgba8;
     uint32_t usage_ = 0;
+    uint64_t memory_bytes_ = 0;
     std::string name_;
 };
 

@@ -3,6 +3,10 @@
 #ifndef NB_BINDINGS_GLSL
 #define NB_BINDINGS_GLSL
 #extension GL_EXT_scalar_block_layout : require
+#ifdef NB_TEXTURE_ARRAY
+// Texture-array variants of the passes that sample textures (shaders/CMakeLists.txt, lib/textures.glsl).
+#extension GL_EXT_nonuniform_qualifier : require
+#endif
 
 #include "shared/compat.h"
 #include "shared/bvh_node.h"
@@ -32,7 +36,8 @@ layout(set = 0, binding = NB_BIND_TRIANGLES, std430) readonly buffer TriangleBuf
 layout(set = 0, binding = NB_BIND_VERTICES, scalar) readonly buffer VertexBuffer { GpuVertex vertices[]; };
 layout(set = 0, binding = NB_BIND_MATERIALS, scalar) readonly buffer MaterialBuffer { GpuMaterial materials[]; };
 layout(set = 0, binding = NB_BIND_TEXTURE_INFOS, scalar) readonly buffer TextureInfoBuffer { GpuTextureInfo texture_infos[]; };
-layout(set = 0, binding = NB_BIND_TEXELS, scalar) readonly buffer TexelBuffer { uint texels[]; };
+// Binding NB_BIND_TEXELS (the texels, or the texture-array images) is declared by lib/textures.glsl, so only
+// the passes that sample textures declare it (and have a texture-array variant, shaders/CMakeLists.txt).
 layout(set = 0, binding = NB_BIND_LIGHTS, scalar) readonly buffer LightBuffer { GpuLight lights[]; };
 layout(set = 0, binding = NB_BIND_LIGHT_CDF, scalar) readonly buffer LightCdfBuffer { float light_cdf[]; };
 // Environment: rgb texels (width*height*3), then the marginal row cdf (height+1), then one conditional

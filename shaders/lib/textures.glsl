@@ -1,9 +1,31 @@
-// Texture fetches from the RGBA8 texel buffer (layout: GpuTextureInfo in shared/scene_gpu.h):
-// bilinear filtering, repeat wrapping, texel centres at half-integers, v = 0 at the top row (glTF).
+// Texture lookups: nb_sample_texture(texture, uv) is the one API; two implementations, chosen per
+// renderer (engine/render/texture_path.h):
+//   default:          the RGBA8 texel buffer (layout: GpuTextureInfo in shared/scene_gpu.h), bilinear in
+//                     the shader;
+//   NB_TEXTURE_ARRAY: one sampler2D per texture (binding NB_BIND_TEXELS), the sampler's bilinear filter.
+// Both: bilinear on the raw 8-bit values, REPEAT wrapping, texel centres at half-integers, v = 0 at the
+// top row (glTF), one level (no mip maps), non-linearised values (the caller decodes sRGB).
 #ifndef NB_TEXTURES_GLSL
 #define NB_TEXTURES_GLSL
 #include "lib/bindings.glsl"
 #include "shared/sampling.h"
+
+#ifdef NB_TEXTURE_ARRAY
+
+// One image per glTF texture (RGBA8 UNORM: raw values, sRGB decoded after filtering as the buffer path
+// does), a bilinear REPEAT sampler, one level (engine/render/texture_array.h).
+layout(set = 0, binding = NB_BIND_TEXELS) uniform sampler2D texture_images[];
+
+// Bilinear lookup; returns the raw (non-linearised) texel values. The wrapped uv (as the buffer path
+// wraps it) keeps huge coordinates as precise as there.
+vec4 nb_sample_texture(int texture, vec2 uv) {
+    return textureLod(texture_images[nonuniformEXT(texture)], uv - floor(uv), 0.0f);
+}
+
+#else
+
+// All textures' RGBA8 texels, packed (layout: GpuTextureInfo at binding NB_BIND_TEXTURE_INFOS).
+layout(set = 0, binding = NB_BIND_TEXELS, scalar) readonly buffer TexelBuffer { uint texels[]; };
 
 vec4 nb_texel(GpuTextureInfo ti, int x, int y) {
     int w = int(ti.width);
@@ -26,6 +48,8 @@ vec4 nb_sample_texture(int texture, vec2 uv) {
     vec4 c = nb_texel(ti, x, y + 1), d = nb_texel(ti, x + 1, y + 1);
     return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
 }
+
+#endif
 
 vec3 nb_srgb_to_linear3(vec3 c) {
     return vec3(nb_srgb_to_linear(c.x), nb_srgb_to_linear(c.y), nb_srgb_to_linear(c.z));

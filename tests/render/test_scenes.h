@@ -7,4 +7,12 @@ namespace nbvh::test {
 // A unit quad in the z = 0 plane facing +z (two triangles), one grey material, one instance.
 Scene make_quad_scene();
 
+// Textures of every kind on quads (texture-path tests): a floor with a non-square sRGB base colour and a
+// metallic-roughness texture under a KHR_texture_transform whose uvs run from -0.3 to 3.2 (REPEAT
+// wrapping), an emissive wall (emissive factor EMISSIVE_SCALE x an sRGB texture with hard edges), a
+// normal-mapped panel, and an alpha-masked quad in front of it. Texture 3 is the emissive one.
+Scene make_textured_scene();
+inline constexpr float TEXTURED_SCENE_EMISSIVE_SCALE = 2.0f;
+inline constexpr int TEXTURED_SCENE_EMISSIVE_TEXTURE = 3;
+
 } // namespace nbvh::test
