@@ -1,4 +1,4 @@
-// nbvh view SCENE [--model M.nbvh] [--env FILE] [--width W --height H] [--device auto|gpu|cpu]
+// nbvh view SCENE [--model M.nbvh] [--env FILE|none] [--width W --height H] [--device auto|gpu|cpu]
 //                 [--max-depth D] [--lod L] [--secondary-lod L] [--neural GLOB]
 //                 [--screenshot FILE.png] [--frames N] [--hide-ui] [--script FILE]
 // The interactive viewer (app/viewer/): progressive path tracing in a window with a UI panel.
@@ -16,7 +16,9 @@ void add_view_command(CLI::App& app) {
     auto* cmd = app.add_subcommand("view", "interactive viewer: progressive path tracing, LoD and node-count sliders");
     cmd->add_option("scene", args->scene, "glTF/GLB file, or 'default' for the built-in scene")->required();
     cmd->add_option("--model", args->model, "N-BVH model (.nbvh) for the scene's neural instances");
-    cmd->add_option("--env", args->env, "environment map (.hdr or .exr, equirectangular)");
+    cmd->add_option("--env", args->env,
+                    "environment map (.hdr or .exr, equirectangular), or 'none' (the scene's lights only); default: "
+                    "the scene's, else the default sky (as nbvh render)");
     cmd->add_option("--neural", args->neural_glob, "nodes whose name matches this glob are neural instances");
     cmd->add_option("--width", args->width, "window width in pixels")->check(CLI::Range(16u, 16384u));
     cmd->add_option("--height", args->height, "window height in pixels")->check(CLI::Range(16u, 16384u));

@@ -10,7 +10,7 @@ namespace nbvh::viewer {
 struct ViewerArgs {
     std::string scene;            // glTF/GLB file or "default"
     std::string model;            // .nbvh for the scene's neural instances (hybrid render)
-    std::string env;              // environment map override
+    std::string env;              // --env FILE | none | "" (app/render_args.h choose_environment)
     std::string neural_glob;      // nodes whose name matches are neural instances
     std::string device = "auto";  // auto | gpu | cpu
     uint32_t width = 1280, height = 720; // window (and initial film) size

@@ -56,6 +56,28 @@ TEST(ViewerCli, HeadlessScreenshotUnderXvfb) {
     EXPECT_GT(hi - lo, 0.1) << "screenshot is (nearly) uniform: " << lo << " .. " << hi;
 }
 
+// --env none as in nbvh render (app/render_args.h choose_environment): only the scene's own lights, so the
+// default scene's sky is black; without it the default sky shows above the horizon.
+TEST(ViewerCli, EnvNoneKeepsOnlyTheScenesLights) {
+    if (!have_xvfb_run()) GTEST_SKIP() << "xvfb-run not installed (Debian: xvfb)";
+    const std::filesystem::path dir = test::temp_dir("viewer_env_none");
+    auto top_row_luminance = [&](const std::string& extra, const std::string& name) {
+        const std::filesystem::path png = dir / (name + ".png"), log = dir / (name + ".txt");
+        const int rc = run("xvfb-run -a " + std::string(NBVH_EXE) + " view default --device cpu --width 96 --height 54 " +
+                           "--frames 2 --hide-ui --screenshot " + png.string() + extra + " > " + log.string() + " 2>&1");
+        EXPECT_EQ(rc, 0) << read_file(log);
+        const Image img = load_image(png.string());
+        double sum = 0.0;
+        for (int x = 0; x < img.width; ++x) {
+            const float* p = img.at(x, 0);
+            sum += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+        }
+        return sum / std::max(1, img.width);
+    };
+    EXPECT_GT(top_row_luminance("", "sky"), 0.05) << "the default sky";
+    EXPECT_EQ(top_row_luminance(" --env none", "none"), 0.0) << "no environment: a black background";
+}
+
 TEST(ViewerCli, NoDisplayIsOneClearLine) {
     const std::filesystem::path dir = test::temp_dir("viewer_no_display");
     const std::filesystem::path log = dir / "log.txt";
