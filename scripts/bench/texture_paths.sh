@@ -9,7 +9,7 @@
 # Camera and environment as scripts/bench/chess.sh. Writes OUT/summary.txt, OUT/texture_paths.json,
 # OUT/gpu_test.txt, OUT/{buffer,array}_stats.json, OUT/array.png, OUT/flip_buffer_array.png.
 # Usage (GPU machine):  source .device/env.sh && scripts/bench/texture_paths.sh DIR $OUT
-#   DIR: bin/nbvh[.xz], bin/nbvh_render_gpu_tests[.xz], scene/abeautifulgame.glb,
+#   DIR: bin/nbvh[.xz], bin/nbvh_render_gpu_tests[.xz], scene/abeautifulgame.glb[.xz],
 #        scene/photo_studio_loft_hall_512x256.hdr, optionally layer/ (VkLayer_khronos_validation.json and
 #        libVkLayer_khronos_validation.so[.xz] from Debian's vulkan-validationlayers). env: SPP (default 32), WIDTH, HEIGHT
 #        (default 1920x1080).
@@ -43,6 +43,7 @@ echo "gpu test exit $?: $(grep -E '^\[  (PASSED|FAILED|SKIPPED) ' "$OUT/gpu_test
 grep -E "^(direct|path traced)" "$OUT/gpu_test.txt" >> "$S"
 
 SCENE=$DIR/scene/abeautifulgame.glb ENV=$DIR/scene/photo_studio_loft_hall_512x256.hdr
+if [ ! -f "$SCENE" ] && [ -f "$SCENE.xz" ]; then unpack "$SCENE.xz"; SCENE=$T/abeautifulgame.glb; fi
 R=("$NBVH" render "$SCENE" --camera "0.600,0.358,0.179,-0.197,-0.197,-0.057,45" --env "$ENV" --env-rotation 285
    --width "$W" --height "$H" --max-depth 8 --exposure 0)
 for p in buffer array; do "${R[@]}" --texture-path $p --explain 2>&1 | grep -A1 "^  textures" >> "$S"; done
