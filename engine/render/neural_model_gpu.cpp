@@ -111,6 +111,10 @@ void pack_lod_nodes(const NeuralModel& model, std::vector<GpuBvhNode>& nodes, st
             for (GpuBvhNode n : tree.to_gpu_layout(lod, a.root)) {
                 if (n.left != NB_CHILD_NONE && !nb_is_leaf(n.left)) n.left += base;
                 if (n.right != NB_CHILD_NONE && !nb_is_leaf(n.right)) n.right += base;
+                // Grown to contain the dilated leaf intervals below (walk culling, shared/neural_gpu.h);
+                // an absent child's empty box (lo > hi) stays empty.
+                if (n.left != NB_CHILD_NONE) nb_neural_cull_bounds(n.lmin, n.lmax);
+                if (n.right != NB_CHILD_NONE) nb_neural_cull_bounds(n.rmin, n.rmax);
                 nodes.push_back(n);
             }
         }

@@ -28,6 +28,7 @@ uint g_nl_cand_leaf[NB_NL_MAX_LEAVES_PER_ROUND];
 float g_nl_cand_entry[NB_NL_MAX_LEAVES_PER_ROUND];
 float g_nl_cand_exit[NB_NL_MAX_LEAVES_PER_ROUND];
 uint g_nl_inst = 0u;              // instance being walked
+float g_nl_walk_tmax = NB_INF;    // the ray's limit (best hit) during a walk; g_tmax culls the walk's nodes
 vec3 g_nl_inv_dir;
 
 bool nb_nl_key_less(float ta, uint ia, uint la, float tb, uint ib, uint lb) {
@@ -47,7 +48,7 @@ void nb_neural_leaf(uint first, uint count) {
             continue;
         if (!(tx > g_tmin)) continue; // the leaf lies behind the ray's start
         float key = max(te, g_tmin);
-        if (!(key < g_tmax)) continue;
+        if (!(key < g_nl_walk_tmax)) continue;
         if (!nb_nl_key_less(g_nl_last_t, g_nl_last_inst, g_nl_last_leaf, key, g_nl_inst, node)) continue;
         if (g_nl_cand_n == g_nl_want) {
             uint w = g_nl_want - 1u;
@@ -71,6 +72,10 @@ void nb_neural_leaf(uint first, uint count) {
         g_nl_cand_leaf[j] = node;
         g_nl_cand_entry[j] = te;
         g_nl_cand_exit[j] = tx;
+        // A full list: no subtree entered behind its worst key can hold a better leaf (the node boxes
+        // contain their dilated leaves, shared/neural_gpu.h nb_neural_cull_bounds), so the walk culls
+        // by it from here on. H100: see the commit of this change.
+        if (g_nl_cand_n == g_nl_want) g_tmax = min(g_tmax, g_nl_cand_t[g_nl_want - 1u]);
     }
 }
 
@@ -83,9 +88,10 @@ void nb_traverse_neural_instance(uint instance) {
     g_obj_org = nb_xform_point(inst.world_to_object, g_org);
     g_obj_dir = nb_xform_vector(inst.world_to_object, g_dir);
     g_nl_inv_dir = nb_safe_inv_dir(g_obj_dir);
-    // Cull subtrees behind the current candidate while walking (restored after: the TLAS and the
-    // triangles are culled by hits only).
+    // Cull subtrees behind the worst kept candidate while walking (narrowed as the list fills; restored
+    // after: the TLAS and the triangles are culled by hits only). Leaves are tested against the hit.
     float saved_tmax = g_tmax;
+    g_nl_walk_tmax = saved_tmax;
     g_tmax = min(g_tmax, nb_nl_bound_t());
     NB_TRAVERSE_BVH(nbvh_nodes, root, g_obj_org, g_nl_inv_dir, nb_neural_leaf)
     g_tmax = saved_tmax;

@@ -70,6 +70,21 @@ NB_FN bool nb_neural_leaf_interval(vec3 org, vec3 inv_dir, vec3 lo, vec3 hi, NB_
     return nb_intersect_aabb_interval(org, inv_dir, c - half_ext, c + half_ext, -NB_INF, NB_INF, t_entry, t_exit);
 }
 
+// Bounds the renderer stores for the N-BVH's nodes (GpuBvhNode child boxes, engine/render/
+// neural_model_gpu.cpp): the node box grown by twice the leaf dilation of its extent plus 1e-6 of its
+// largest coordinate (and 1e-30), so that every leaf interval nb_neural_leaf_interval computes below a
+// node (dilated about the leaf's centre, with float rounding) lies inside the node's box. Slab entry
+// distances are monotonic in the box bounds, so a subtree whose box a ray enters after t is entered by
+// none of its leaves before t: the walk may cull by the round's worst kept leaf key (lib/
+// neural_traverse.glsl) without dropping a leaf.
+NB_FN void nb_neural_cull_bounds(NB_INOUT(vec3) lo, NB_INOUT(vec3) hi) {
+    vec3 m = max(abs(lo), abs(hi));
+    float pad = max(1e-6f * max(m.x, max(m.y, m.z)), 1e-30f);
+    vec3 grow = (hi - lo) * (2.0f * NB_LEAF_DILATION) + vec3(pad);
+    lo = lo - grow;
+    hi = hi + grow;
+}
+
 // fp16 <-> uint packing on the host matches unpackHalf2x16: element 2k in bits 0..15, 2k+1 in 16..31.
 
 // ---- Renderer integration (wavefront loop, engine/render/neural_stage.h) ---------------------------
