@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# A/B frame times of two nbvh binaries in one run on one GPU (issue 14: each step's measurement):
+# hybrid and classical 1920x1080 frames of the default scene and the dragon, max depth 8, the models
+# trained once (CUDA defaults of the NEW binary; the model format is shared), then per row a warm-up
+# render and OLD, NEW, OLD, NEW (interleaved: clocks and caches drift alike), same seed. Reports the
+# fastest of each binary's two renders in ms per sample, per-pass times, and the FLIP between the OLD and
+# NEW images (0 when the change is exact). Writes OUT/ab.json and prints a table.
+# Usage (GPU machine, after `source .device/env.sh`): scripts/bench/ab_frames.sh OLD NEW OUT
+# Env: DRAGON (xz-packed glb, default .device/study/dragon/dragon_vrip.glb.xz), SPP (default 16), WIDTH, HEIGHT,
+#      TRAIN_ARGS (extra `nbvh train` flags for both models), RENDER_ARGS (extra render flags, both binaries).
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+OLD=$1 NEW=$2 OUT=$3
+DRAGON=${DRAGON:-.device/study/dragon/dragon_vrip.glb.xz}
+SPP=${SPP:-16}
+T=${TMPDIR:-/tmp}/nbvh_ab
+mkdir -p "$OUT" "$T"
+python3 -c 'import lzma, shutil, sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2], "wb"))' "$DRAGON" "$T/dragon.glb"
+(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader || echo "no nvidia-smi") | tee "$OUT/device.txt"
+# shellcheck disable=SC2206
+R=(--width "${WIDTH:-1920}" --height "${HEIGHT:-1080}" --max-depth 8 --exposure 0 ${RENDER_ARGS:-})
+# shellcheck disable=SC2206
+TA=(${TRAIN_ARGS:-})
+"$NEW" train default "${TA[@]}" --out "$T/default.nbvh" > "$T/train_default.log" 2>&1
+"$NEW" train "$T/dragon.glb" --neural '*' "${TA[@]}" --out "$T/dragon.nbvh" > "$T/train_dragon.log" 2>&1
+row() { # NAME ARGS...
+  local name=$1; shift
+  "$NEW" render "$@" "${R[@]}" --spp 4 --out "$T/warm.png" > /dev/null 2>&1
+  for rep in 1 2; do
+    for b in old new; do
+      local bin=$OLD; [ $b = new ] && bin=$NEW
+      "$bin" render "$@" "${R[@]}" --spp "$SPP" --out "$T/${name}_$b.png" --stats "$T/${name}_${b}_$rep.json" > /dev/null 2>&1
+    done
+  done
+  "$NEW" flip "$T/${name}_old.png" "$T/${name}_new.png" 2>&1 | tail -1 > "$T/${name}_flip.txt"
+}
+row default_classical default --classical
+row default_hybrid default --model "$T/default.nbvh"
+row dragon_classical "$T/dragon.glb" --neural '*' --classical
+row dragon_hybrid "$T/dragon.glb" --model "$T/dragon.nbvh"
+python3 - "$T" "$OUT/ab.json" "$OLD" "$NEW" <<'PY'
+import glob, json, os, re, sys
+t, out = sys.argv[1], sys.argv[2]
+rows = {}
+for name in ["default_classical", "default_hybrid", "dragon_classical", "dragon_hybrid"]:
+    r = {}
+    for b in ["old", "new"]:
+        runs = [json.load(open(f)) for f in sorted(glob.glob(os.path.join(t, f"{name}_{b}_*.json")))]
+        best = min(runs, key=lambda j: j["gpu_total_ms"])
+        spp = best["spp"]
+        r[b] = {"ms_per_spp": best["gpu_total_ms"] / spp, "all_ms_per_spp": [j["gpu_total_ms"] / spp for j in runs],
+                "passes_ms_per_spp": {k.split("/")[-1].replace(".comp", ""): v / spp for k, v in best["pass_gpu_ms"].items()},
+                "rays_per_second": best["rays_per_second"], "neural": best.get("neural")}
+    m = re.search(r"[-+]?\d*\.\d+(?:[eE][-+]?\d+)?|\d+", open(os.path.join(t, f"{name}_flip.txt")).read())
+    r["flip_ldr_old_vs_new"] = float(m.group()) if m else None
+    r["new_over_old"] = r["new"]["ms_per_spp"] / r["old"]["ms_per_spp"]
+    rows[name] = r
+json.dump({"old": sys.argv[3], "new": sys.argv[4], "rows": rows}, open(out, "w"), indent=1)
+for k, r in rows.items():
+    print("%-18s old %6.2f  new %6.2f ms/spp  new/old %.3f  FLIP old vs new %s" % (
+        k, r["old"]["ms_per_spp"], r["new"]["ms_per_spp"], r["new_over_old"], r["flip_ldr_old_vs_new"]))
+PY
