@@ -43,7 +43,7 @@ EvalStats evaluate_network(const TrainingAsset& asset, const TrainingCut& cut, c
         if (hit && gt.hit) {
             e.both_hit++;
             float t_pred;
-            nb_decode_depth(asset.encoding, y[NB_OUT_DEPTH], 0.0f, len, t_pred);
+            nb_decode_depth(asset.encoding, y[NB_OUT_DEPTH], 0.0f, len, glm::length(d), t_pred);
             const double err = std::abs(double(t_pred) - double(gt.t_hit));
             depth_err.push_back(len > 0.0f ? err / double(len) : 0.0);
             depth_abs_sum += diag > 0.0f ? err / double(diag) : 0.0;

@@ -44,5 +44,5 @@ void main() {
         float pre = NB_EVAL_PART == 1u ? nb_coop_x_read(local, r * 12u) : nb_sh_y[local * NB_COOP_Y_STRIDE + r];
         y[r] = nb_sigmoid(pre);
     }
-    hits[i] = nb_neural_decode(pc.box, y, q.t_entry, q.t_exit, pc.threshold);
+    hits[i] = nb_neural_decode(pc.box, y, q.t_entry, q.t_exit, length(q.dir), pc.threshold);
 }

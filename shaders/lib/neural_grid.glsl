@@ -109,15 +109,16 @@ void nb_neural_point_features(vec3 p, out float f[NB_POINT_FEATURES]) {
 }
 
 // Decode the 8 outputs (after the sigmoid) of one query into a hit (shared/neural_query.h).
+// dir_len: |direction| of the query's ray in the encoding space (nb_decode_depth).
 GpuNeuralHit nb_neural_decode(GpuEncodingBox box, float y[NB_MLP_OUTPUTS], float t_entry, float t_exit,
-                              float threshold) {
+                              float dir_len, float threshold) {
     GpuNeuralHit h;
     h.visibility = y[NB_OUT_VISIBILITY];
     h.depth = y[NB_OUT_DEPTH];
     h.normal = nb_decode_normal(y[NB_OUT_NORMAL], y[NB_OUT_NORMAL + 1u], y[NB_OUT_NORMAL + 2u]);
     h.albedo = vec3(y[NB_OUT_ALBEDO], y[NB_OUT_ALBEDO + 1u], y[NB_OUT_ALBEDO + 2u]);
     float t_hit;
-    bool accepted = nb_decode_depth(box, y[NB_OUT_DEPTH], t_entry, t_exit, t_hit);
+    bool accepted = nb_decode_depth(box, y[NB_OUT_DEPTH], t_entry, t_exit, dir_len, t_hit);
     h.t = t_hit;
     h.flags = (nb_decode_visibility(y[NB_OUT_VISIBILITY], threshold) ? NB_NEURAL_VISIBLE : 0u) |
               (accepted ? NB_NEURAL_ACCEPTED : 0u);

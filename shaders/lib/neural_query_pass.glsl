@@ -43,7 +43,8 @@ NbPendingQuery nb_load_pending(uint k) {
 // The accepted hit of a pair (t NB_INF: none): visible and accepted, in front of the ray's start and
 // its tmax (shadow rays); world-space normal.
 float nb_neural_pair_hit(NbPendingQuery r, float y[NB_MLP_OUTPUTS], out vec3 normal, out vec3 albedo) {
-    GpuNeuralHit h = nb_neural_decode(neural_params.box, y, r.pl.t_enter, r.pl.t_exit, neural_params.threshold);
+    GpuNeuralHit h = nb_neural_decode(neural_params.box, y, r.pl.t_enter, r.pl.t_exit, length(r.dir),
+                                      neural_params.threshold);
     uint ray = r.pl.ray;
     uint cap = ray_capacity();
     bool shadow = ray >= cap;

@@ -16,5 +16,5 @@ void main() {
     nb_segment_points(pc.box, q.origin, q.dir, q.t_entry, q.t_exit, p0, p1, p2);
     float y[NB_MLP_OUTPUTS];
     nb_neural_forward_scalar(p0, p1, p2, y);
-    hits[i] = nb_neural_decode(pc.box, y, q.t_entry, q.t_exit, pc.threshold);
+    hits[i] = nb_neural_decode(pc.box, y, q.t_entry, q.t_exit, length(q.dir), pc.threshold);
 }

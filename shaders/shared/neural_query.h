@@ -106,20 +106,29 @@ NB_FN bool nb_decode_visibility(float y0, float threshold) { return y0 > thresho
 
 // Depth decode (LocalT). Returns false when the inside-origin margin rejects the hit; t_hit is the ray
 // parameter of the hit along the FORWARD ray either way.
-NB_FN bool nb_decode_depth(GpuEncodingBox box, float y1, float t_entry, float t_exit,
+// dir_len: the length of the ray direction in the encoding (object) space. The box's depth_pad and
+// fixed_depth_eps are object-space lengths and training rays have unit directions there, while the
+// renderer's rays keep their world-space parameter (object direction of length 1 / the instance's
+// scale): the pads are converted to ray-parameter units by 1 / dir_len. (Without it the pad grew
+// relative to the leaf as an instance shrank: hit depths pushed up to ~20 % of a leaf deeper on Chess's
+// 5 cm pieces, and the same model rendered differently at 0.1 m and 1 m.) A non-positive or NaN dir_len
+// counts as 1.
+NB_FN bool nb_decode_depth(GpuEncodingBox box, float y1, float t_entry, float t_exit, float dir_len,
                            NB_OUT(float) t_hit) {
     float u = nb_clamp_safe(y1, 0.0f, 1.0f);
     float len = max(t_exit - t_entry, 0.0f);
-    float d = u * (len + box.depth_pad);
+    float to_t = dir_len > 0.0f ? 1.0f / dir_len : 1.0f;
+    float d = u * (len + box.depth_pad * to_t);
     if (nb_query_reversed(t_entry)) {
         t_hit = t_exit - d;
-        return d < t_exit - NB_DEPTH_EPSILON * len - box.fixed_depth_eps;
+        return d < t_exit - NB_DEPTH_EPSILON * len - box.fixed_depth_eps * to_t;
     }
     t_hit = t_entry + d;
     return true;
 }
 
 // Training target of the depth output for a hit at t_hit (forward ray parameter) inside the query.
+// Training rays have unit directions in the encoding space (t is an object-space length).
 NB_FN float nb_encode_depth_target(GpuEncodingBox box, float t_hit, float t_entry, float t_exit,
                                    bool reversed) {
     float len = max(t_exit - t_entry, 0.0f);

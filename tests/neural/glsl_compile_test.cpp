@@ -34,7 +34,7 @@ void main() {
             acc += nb_grid_corner_weight(frac, c) * float(grid[nb_grid_corner_entry(levels[l], cell, c) * NB_GRID_FEATURES]);
     }
     float t;
-    bool ok = nb_decode_depth(box, nb_sigmoid(nb_relu(acc)), -0.5f, 0.5f, t);
+    bool ok = nb_decode_depth(box, nb_sigmoid(nb_relu(acc)), -0.5f, 0.5f, 1.0f, t);
     vec3 n = nb_decode_normal(acc, 0.5f, 0.25f);
     uint slot = nb_feature_slot(2u, 7u, 3u) + nb_mlp_weight_index(4u, 15u, 63u) + nb_mlp_layer_outputs(0u);
     outv[gl_GlobalInvocationID.x] = t + n.x + float(slot) + (rev ? 1.0f : 0.0f) + (ok ? 1.0f : 0.0f) +

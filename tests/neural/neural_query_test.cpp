@@ -65,21 +65,21 @@ TEST(NeuralQuery, DecodeDepthOutsideAndInside) {
     const GpuEncodingBox b = nb_make_encoding_box(vec3(0.0f), vec3(1.0f));
     float t = 0.0f;
     // outside: t = t_entry + u (L + 1e-3)
-    EXPECT_TRUE(nb_decode_depth(b, 0.5f, 2.0f, 4.0f, t));
+    EXPECT_TRUE(nb_decode_depth(b, 0.5f, 2.0f, 4.0f, 1.0f, t));
     EXPECT_FLOAT_EQ(t, 2.0f + 0.5f * 2.001f);
-    EXPECT_TRUE(nb_decode_depth(b, 1.7f, 2.0f, 4.0f, t)); // u clamped to 1
+    EXPECT_TRUE(nb_decode_depth(b, 1.7f, 2.0f, 4.0f, 1.0f, t)); // u clamped to 1
     EXPECT_FLOAT_EQ(t, 2.0f + 2.001f);
-    EXPECT_TRUE(nb_decode_depth(b, std::nanf(""), 2.0f, 4.0f, t)); // NaN -> u = 0, no NaN out
+    EXPECT_TRUE(nb_decode_depth(b, std::nanf(""), 2.0f, 4.0f, 1.0f, t)); // NaN -> u = 0, no NaN out
     EXPECT_FLOAT_EQ(t, 2.0f);
     // inside: t_entry = -1, t_exit = 1, L = 2; d = u * 2.001 measured back from the exit;
     // accepted iff d < 1 - 0.2 * 2 - 1e-5 = 0.59999
-    EXPECT_TRUE(nb_decode_depth(b, 0.25f, -1.0f, 1.0f, t)); // d = 0.50025
+    EXPECT_TRUE(nb_decode_depth(b, 0.25f, -1.0f, 1.0f, 1.0f, t)); // d = 0.50025
     EXPECT_FLOAT_EQ(t, 1.0f - 0.25f * 2.001f);
-    EXPECT_FALSE(nb_decode_depth(b, 0.3f, -1.0f, 1.0f, t)); // d = 0.6003 -> too close to the origin
+    EXPECT_FALSE(nb_decode_depth(b, 0.3f, -1.0f, 1.0f, 1.0f, t)); // d = 0.6003 -> too close to the origin
     EXPECT_FLOAT_EQ(t, 1.0f - 0.3f * 2.001f);
     // target encoding inverts the decode
     const float u = nb_encode_depth_target(b, 3.0f, 2.0f, 4.0f, false);
-    EXPECT_TRUE(nb_decode_depth(b, u, 2.0f, 4.0f, t));
+    EXPECT_TRUE(nb_decode_depth(b, u, 2.0f, 4.0f, 1.0f, t));
     EXPECT_NEAR(t, 3.0f, 1e-6f);
     EXPECT_NEAR(nb_encode_depth_target(b, 0.5f, -1.0f, 1.0f, true), 0.5f / 2.001f, 1e-7f);
 }
@@ -145,10 +145,41 @@ TEST(NeuralQuery, ExtremeScalesAndBadIntervalsGiveFiniteInputs) {
                 EXPECT_GE(p0.x, NB_ENC_CLAMP_LO);
                 EXPECT_LE(p2.z, NB_ENC_CLAMP_HI);
                 float th = 0.0f;
-                nb_decode_depth(b, 0.5f, t[0], t[1], th);
+                nb_decode_depth(b, 0.5f, t[0], t[1], 1.0f, th);
                 if (std::isfinite(t[0]) && std::isfinite(t[1])) {
                     EXPECT_TRUE(std::isfinite(th));
                 }
             }
     }
+}
+
+// The depth decode is the same hit at every instance scale: a leaf segment of object length L with the
+// network's u decodes to the same object-space point whether the ray's object-space direction has length
+// 1 (training) or k (the renderer's rays: 1 / the instance's scale; Chess pieces are ~20, a 1e4 m asset
+// 1e-4), forward and with the origin inside the leaf (reversed), and the inside-origin margin accepts or
+// rejects alike. Before the pads were converted by 1 / |dir| a 5 cm piece decoded hits up to 20 % of its
+// leaf deeper than trained.
+TEST(NeuralQuery, DepthDecodeIsTheSameHitAtEveryInstanceScale) {
+    const GpuEncodingBox b = nb_make_encoding_box(vec3(-1.0f), vec3(1.0f));
+    const float lengths[] = {1.0e-3f, 0.02f, 0.5f};
+    const float us[] = {0.0f, 0.1f, 0.5f, 0.93f, 1.0f};
+    const float scales[] = {1.0e-4f, 0.05f, 1.0f, 20.0f, 1.0e4f};
+    for (float len : lengths)
+        for (float u : us)
+            for (float entry_frac : {0.3f, -0.4f}) { // forward, and the origin 40 % into the leaf
+                const float te = entry_frac * len, tx = te + len; // unit direction: t in object units
+                float t1;
+                const bool acc1 = nb_decode_depth(b, u, te, tx, 1.0f, t1);
+                for (float k : scales) {
+                    float tk;
+                    const bool acck = nb_decode_depth(b, u, te / k, tx / k, k, tk);
+                    EXPECT_EQ(acck, acc1) << "len " << len << " u " << u << " k " << k;
+                    EXPECT_NEAR(tk * k, t1, 2e-6f * (std::abs(t1) + len)) << "len " << len << " u " << u << " k " << k;
+                }
+            }
+    float t;
+    EXPECT_TRUE(nb_decode_depth(b, 0.5f, 2.0f, 4.0f, 0.0f, t)); // a zero length counts as 1
+    EXPECT_FLOAT_EQ(t, 2.0f + 0.5f * (2.0f + b.depth_pad));
+    EXPECT_TRUE(nb_decode_depth(b, 0.5f, 2.0f, 4.0f, std::nanf(""), t));
+    EXPECT_TRUE(std::isfinite(t));
 }

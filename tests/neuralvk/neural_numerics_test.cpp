@@ -65,8 +65,8 @@ void run_cases(const test::TestModel& tm, const std::vector<Case>& cases) {
         EXPECT_NEAR(h.visibility, y[0], 2e-3f) << name;
         EXPECT_NEAR(h.depth, y[1], 2e-3f) << name;
         float t_ref;
-        nb_decode_depth(tm.box, y[1], qs[i].t_entry, qs[i].t_exit, t_ref);
-        const float len = qs[i].t_exit - qs[i].t_entry + tm.box.depth_pad;
+        nb_decode_depth(tm.box, y[1], qs[i].t_entry, qs[i].t_exit, glm::length(qs[i].dir), t_ref);
+        const float len = qs[i].t_exit - qs[i].t_entry + tm.box.depth_pad / glm::length(qs[i].dir);
         EXPECT_NEAR(h.t, t_ref, 2e-3f * len) << name;
         // A reversed query never accepts a hit behind (or at) the origin: no self-hit of a secondary
         // ray leaving a neural surface inside this leaf.

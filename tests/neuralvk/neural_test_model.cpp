@@ -85,11 +85,13 @@ CrossCheck cross_check(const TestModel& m, const std::vector<GpuNeuralQuery>& qs
         }
         c.visible += ref_vis;
         float t_ref;
-        const bool acc_ref = nb_decode_depth(m.box, y[NB_OUT_DEPTH], qs[i].t_entry, qs[i].t_exit, t_ref);
+        const bool acc_ref = nb_decode_depth(m.box, y[NB_OUT_DEPTH], qs[i].t_entry, qs[i].t_exit, glm::length(qs[i].dir), t_ref);
         c.reversed += nb_query_reversed(qs[i].t_entry);
-        const float len = std::max(qs[i].t_exit - qs[i].t_entry, 0.0f) + m.box.depth_pad;
+        const float to_t = 1.0f / glm::length(qs[i].dir); // object lengths -> ray parameter (nb_decode_depth)
+        const float len = std::max(qs[i].t_exit - qs[i].t_entry, 0.0f) + m.box.depth_pad * to_t;
         c.max_t = std::max(c.max_t, std::abs(h.t - t_ref) / len);
-        if (std::abs(t_ref - qs[i].t_exit + NB_DEPTH_EPSILON * (len - m.box.depth_pad) + m.box.fixed_depth_eps) >
+        if (std::abs(t_ref - qs[i].t_exit + NB_DEPTH_EPSILON * (len - m.box.depth_pad * to_t) +
+                     m.box.fixed_depth_eps * to_t) >
             vis_margin * len)
             c.acceptance_errors += ((h.flags & NB_NEURAL_ACCEPTED) != 0) != acc_ref;
         const glm::vec3 nraw(2 * y[2] - 1, 2 * y[3] - 1, 2 * y[4] - 1);
