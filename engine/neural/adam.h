@@ -1,19 +1,18 @@
-// Adam with tiny-cuda-nn semantics (notes tiny-cuda-nn §C.2, official notes §5): fp32 master weights,
-// fp32 first/second moments and a uint32 step counter PER PARAMETER.
-//   g = grad / loss_scale
-//   grid (non-matrix) params: if g == 0 exactly, the parameter is skipped entirely (no moment decay, no
-//     step increment: a sparse/lazy update of hash entries no sample touched); l2 = non_matrix_l2_reg
+// Adam with tiny-cuda-nn semantics (notes tiny-cuda-nn §C.2, official notes §5) on the CPU: fp32 master
+// weights, fp32 first/second moments and a uint32 step counter PER PARAMETER. The per-parameter update
+// (moments, folded bias correction, l2, the skip of zero grid gradients) is nb_adam_update of
+// engine/neural/shared/adam_update.h, shared with the CUDA trainer; this class owns the state, divides
+// the gradients by loss_scale (g = grad / loss_scale) and applies the update with
+//   grid (non-matrix) params: exactly zero g skipped (sparse/lazy); l2 = non_matrix_l2_reg
 //   MLP (matrix) params: always updated; l2 = l2_reg
-//   g += l2 * w;  m = b1 m + (1-b1) g;  v = b2 v + (1-b2) g^2;  t = ++step[i]
-//   w -= lr * sqrt(1 - b2^t) / (1 - b1^t) / (sqrt(v) + eps) * m
-// (eps is added to sqrt of the UNCORRECTED v, tcnn's folded form; PyTorch differs by sqrt(1-b2^t) on
-// eps.) AdaBound, weight clipping and relative/absolute decay are tcnn options N-BVH leaves off; they
+// AdaBound, weight clipping and relative/absolute decay are tcnn options N-BVH leaves off; they
 // are not implemented. The learning rate comes from ExponentialDecay (lr_at_step), N-BVH defaults.
 #pragma once
 #include <cstdint>
 #include <vector>
 
 #include "engine/neural/reference_network.h"
+#include "engine/neural/shared/adam_update.h"
 
 namespace nbvh::neural {
 
@@ -60,7 +59,7 @@ private:
     uint64_t steps_ = 0;
     std::vector<float> mlp_m_, mlp_v_, grid_m_, grid_v_;
     std::vector<uint32_t> mlp_t_, grid_t_;
-    // Bias-correction factors by per-parameter step t (sqrt(1 - beta2^t) and 1 - beta1^t), computed
+    // Bias-correction factors by per-parameter step t (nb_adam_bias_sqrt / nb_adam_bias_div), computed
     // once per t instead of two powf per parameter and step; identical values.
     std::vector<float> bias_sqrt_, bias_div_;
 };

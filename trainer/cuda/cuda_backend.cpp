@@ -126,17 +126,8 @@ public:
         c.l2_reg = adam.l2_reg;
         c.non_matrix_l2_reg = adam.non_matrix_l2_reg;
         c.skip_zero_grad_non_matrix = adam.skip_zero_grad_non_matrix;
-        const neural::LossConfig loss; // paper weights, linearised normals, masking (as the CPU backend)
-        c.w_vis = loss.w_visibility;
-        c.w_depth = loss.w_depth;
-        c.w_normal = loss.w_normal;
-        c.w_albedo = loss.w_albedo;
-        c.normal_linear = loss.normal_linear;
-        c.masking = loss.visibility_masking;
-        c.bce_clamp = NB_BCE_CLAMP;
-        c.rel_l2_eps = NB_REL_L2_EPS;
-        c.normal_scale = NB_NORMAL_LINEAR_SCALE;
-        c.normal_offset = NB_NORMAL_LINEAR_OFFSET;
+        // Paper weights, linearised normals, masking (as the CPU backend).
+        c.loss = neural::to_gpu(neural::LossConfig{});
         c.deterministic = options.deterministic;
         c.loss_scale = options.loss_scale;
         if (!(c.loss_scale >= 1.0f && c.loss_scale <= 65536.0f)) throw Error("CUDA loss scale must be in [1, 65536]");

@@ -8,6 +8,7 @@
 
 #include "trainer/cuda/cuda_core.h"
 #include "trainer/cuda/device_common.cuh"
+#include "engine/neural/shared/adam_update.h"
 
 namespace nbvh::cuda {
 namespace {
@@ -93,28 +94,19 @@ __global__ void k_check_grid(float* grad, const unsigned long long* fx, uint32_t
     if (!isfinite(g)) atomicOr(flag, NB_GUARD_GRADIENT);
 }
 
-struct AdamParams {
-    float lr, beta1, beta2, eps, l2, scale_inv_num; // scale_inv_num: 1 / loss scale
-    int skip_zero;
-};
-
-// tcnn Adam as engine/neural/adam.cpp (per-parameter step counters; sparse skip of zero grid grads).
-// Does nothing when the guard flag is set or no sample was trained.
+// tcnn Adam: nb_adam_update of engine/neural/shared/adam_update.h, the CPU's update (per-parameter step
+// counters; sparse skip of zero grid grads) on the batch-mean gradient (summed gradient / (loss scale x
+// trained samples)), then the fp16 copy. Does nothing when the guard flag is set or no sample was trained.
 __global__ void k_adam(float* w, float* m, float* v, uint32_t* t, __half* wh, const float* grad, uint32_t n,
-                       AdamParams p, const uint32_t* flag, const uint32_t* valid) {
+                       GpuAdamRule r, float scale_inv, const uint32_t* flag, const uint32_t* valid) {
     const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= n || *flag != 0u || *valid == 0u) return;
-    float g = grad[i] * (p.scale_inv_num / float(*valid));
-    if (g == 0.0f && p.skip_zero) return;
-    float wi = w[i];
-    g += p.l2 * wi;
-    const float mi = p.beta1 * m[i] + (1.0f - p.beta1) * g;
-    const float vi = p.beta2 * v[i] + (1.0f - p.beta2) * g * g;
-    const uint32_t ti = ++t[i];
-    const float lr_t = p.lr * sqrtf(1.0f - powf(p.beta2, float(ti))) / (1.0f - powf(p.beta1, float(ti)));
-    wi -= lr_t / (sqrtf(vi) + p.eps) * mi;
+    float wi = w[i], mi = m[i], vi = v[i];
+    uint32_t ti = t[i];
+    if (!nb_adam_update(wi, mi, vi, ti, grad[i] * (scale_inv / float(*valid)), r, nullptr, nullptr, 0u)) return;
     m[i] = mi;
     v[i] = vi;
+    t[i] = ti;
     w[i] = wi;
     wh[i] = __float2half_rn(wi);
 }
@@ -232,9 +224,7 @@ public:
         record(2);
         launch_encode(net_, batch_, s);
         record(3);
-        LossParams lp{cfg_.w_vis, cfg_.w_depth, cfg_.w_normal, cfg_.w_albedo, cfg_.normal_linear ? 1 : 0,
-                      cfg_.masking ? 1 : 0, scale_, cfg_.bce_clamp, cfg_.rel_l2_eps, cfg_.normal_scale,
-                      cfg_.normal_offset};
+        const LossParams lp{cfg_.loss, scale_};
         launch_mlp(net_, batch_, lp, slices_.p, blocks, flag, s);
         record(4);
         launch_grid_backward(net_, batch_, cfg_.deterministic, flag, s);
@@ -245,13 +235,14 @@ public:
         k_reduce_mlp<<<(NB_MLP_WEIGHT_COUNT + 255) / 256, 256, 0, s>>>(slices_.p, blocks, mlp_grad_.p, flag);
         k_check_grid<<<(grid_n_ + 255) / 256, 256, 0, s>>>(grid_grad_.p, cfg_.deterministic ? grid_grad_fx_.p : nullptr,
                                                              grid_n_, flag);
-        AdamParams ap{in.learning_rate, cfg_.beta1, cfg_.beta2, cfg_.epsilon, cfg_.l2_reg, 1.0f / scale_, 0};
+        const GpuAdamRule mlp_rule{in.learning_rate, cfg_.beta1, cfg_.beta2, cfg_.epsilon, cfg_.l2_reg, 0u};
+        const GpuAdamRule grid_rule{in.learning_rate, cfg_.beta1, cfg_.beta2, cfg_.epsilon, cfg_.non_matrix_l2_reg,
+                                    cfg_.skip_zero_grad_non_matrix ? 1u : 0u};
         k_adam<<<(NB_MLP_WEIGHT_COUNT + 255) / 256, 256, 0, s>>>(mlp_w_.p, mlp_m_.p, mlp_v_.p, mlp_t_.p, mlp_h_.p,
-                                                                  mlp_grad_.p, NB_MLP_WEIGHT_COUNT, ap, flag, valid);
-        ap.l2 = cfg_.non_matrix_l2_reg;
-        ap.skip_zero = cfg_.skip_zero_grad_non_matrix ? 1 : 0;
+                                                                  mlp_grad_.p, NB_MLP_WEIGHT_COUNT, mlp_rule,
+                                                                  1.0f / scale_, flag, valid);
         k_adam<<<(grid_n_ + 255) / 256, 256, 0, s>>>(grid_w_.p, grid_m_.p, grid_v_.p, grid_t_.p, grid_h_.p,
-                                                      grid_grad_.p, grid_n_, ap, flag, valid);
+                                                      grid_grad_.p, grid_n_, grid_rule, 1.0f / scale_, flag, valid);
         NBVH_CUDA_CHECK(cudaGetLastError());
         record(6);
 

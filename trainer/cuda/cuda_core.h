@@ -11,6 +11,7 @@
 #include "shaders/shared/bvh_node.h"
 #include "shaders/shared/hashgrid.h"
 #include "shaders/shared/neural_query.h"
+#include "engine/neural/shared/training_loss.h"
 
 namespace nbvh::cuda {
 
@@ -45,10 +46,9 @@ struct CoreConfig {
     std::vector<float> mlp;             // initial fp32 MLP (19456)
     float beta1 = 0.9f, beta2 = 0.999f, epsilon = 1e-8f, l2_reg = 1e-8f, non_matrix_l2_reg = 0.0f;
     bool skip_zero_grad_non_matrix = true;
-    // Loss weights (paper 2, 2, 1, 1), linearised normals, visibility masking (engine/neural/losses.h).
-    float w_vis = 2.0f, w_depth = 2.0f, w_normal = 1.0f, w_albedo = 1.0f;
-    bool normal_linear = true, masking = true;
-    float bce_clamp = 0, rel_l2_eps = 0, normal_scale = 0, normal_offset = 0; // losses.h NB_* constants
+    // Loss weights (paper 2, 2, 1, 1), linearised normals, visibility masking
+    // (engine/neural/shared/training_loss.h; the host sets it from neural::LossConfig).
+    GpuLossConfig loss{2.0f, 2.0f, 1.0f, 1.0f, 1u, 1u};
     bool deterministic = false;
     float loss_scale = 128.0f;          // initial per-sample loss scale (power of two)
 };

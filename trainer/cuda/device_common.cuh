@@ -13,6 +13,7 @@
 #include "shaders/shared/intersect.h"
 #include "shaders/shared/mlp.h"
 #include "shaders/shared/neural_query.h"
+#include "engine/neural/shared/training_loss.h"
 
 #define NBVH_CUDA_CHECK(expr)                                                                          \
     do {                                                                                               \
@@ -108,10 +109,8 @@ void launch_sample(const DevAsset& a, const DevCuts& c, const DevBatch& b, uint3
 void launch_ground_truth(const DevAsset& a, const DevBatch& b, cudaStream_t s);
 void launch_encode(const DevNetwork& net, const DevBatch& b, cudaStream_t s);
 struct LossParams {
-    float w_vis, w_depth, w_normal, w_albedo;
-    int normal_linear, masking;
-    float loss_scale;
-    float bce_clamp, rel_l2_eps, normal_scale, normal_offset; // engine/neural/losses.h constants
+    GpuLossConfig loss; // the composite loss (engine/neural/shared/training_loss.h)
+    float loss_scale;   // per-sample fp16 loss scale applied to dL/dz
 };
 int mlp_blocks_for(uint32_t n);
 void mlp_prepare();

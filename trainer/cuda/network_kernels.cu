@@ -248,8 +248,6 @@ __device__ void store_weight_grad(float* dst, int cols, int tr, int tc0, FragC (
         wmma::store_matrix_sync(dst + size_t(tr) * 16 * cols + (tc0 + q) * 16, acc[q], cols, wmma::mem_row_major);
 }
 
-__device__ float sgnf(float x) { return x > 0.0f ? 1.0f : (x < 0.0f ? -1.0f : 0.0f); }
-
 static_assert(NB_MLP_INPUTS == 96 && NB_MLP_WIDTH == 64 && NB_MLP_HIDDEN_LAYERS == 4 && kWarps == 8,
               "k_mlp's warp-to-tile assignment is written for 96 -> 64x4 -> 16 and 8 warps");
 
@@ -334,37 +332,16 @@ k_mlp(DevNetwork net, DevBatch b, LossParams lp, float* slices, uint32_t* flag) 
                     if (!finite) {
                         atomicOr(flag, NB_GUARD_OUTPUT);
                     } else {
-                        // engine/neural/losses.cpp composite_loss, same formulas.
-                        const float p = fminf(fmaxf(y[0], lp.bce_clamp), 1.0f - lp.bce_clamp);
-                        const float tv = t[0];
-                        const float l0 = lp.w_vis * -(tv * logf(p) + (1.0f - tv) * logf(1.0f - p));
-                        g[0] = lp.w_vis * -(tv - p) / (p - p * p);
-                        float ld = 0.0f, ln = 0.0f, la = 0.0f;
-                        if (!(lp.masking && tv < 0.5f)) {
-                            const float dd = y[1] - t[1];
-                            ld = lp.w_depth * fabsf(dd);
-                            g[1] = lp.w_depth * sgnf(dd);
-                            const float sc = lp.normal_linear ? lp.normal_scale : 1.0f;
-                            const float of = lp.normal_linear ? lp.normal_offset : 0.0f;
-                            for (int o = 2; o < 5; ++o) {
-                                const float dn = sc * y[o] - of - t[o];
-                                ln += lp.w_normal * fabsf(dn);
-                                g[o] = lp.w_normal * sc * sgnf(dn);
-                            }
-                            for (int o = 5; o < 8; ++o) {
-                                const float da = y[o] - t[o];
-                                const float den = y[o] * y[o] + lp.rel_l2_eps;
-                                la += lp.w_albedo * da * da / den;
-                                g[o] = lp.w_albedo * 2.0f * da / den;
-                            }
-                        }
-                        lv[0] = l0 / lp.w_vis;
-                        lv[1] = ld / lp.w_depth;
-                        lv[2] = ln / (3.0f * lp.w_normal);
-                        lv[3] = la / (3.0f * lp.w_albedo);
-                        lv[4] = l0 + ld + ln + la;
+                        // The CPU's composite loss (engine/neural/shared/training_loss.h); the statistics
+                        // are the unweighted terms, normal and albedo as means over their 3 channels.
+                        float u[8];
+                        lv[4] = nb_composite_loss(y, t, lp.loss, u, g);
+                        lv[0] = u[NB_OUT_VISIBILITY];
+                        lv[1] = u[NB_OUT_DEPTH];
+                        lv[2] = (u[NB_OUT_NORMAL] + u[NB_OUT_NORMAL + 1] + u[NB_OUT_NORMAL + 2]) / 3.0f;
+                        lv[3] = (u[NB_OUT_ALBEDO] + u[NB_OUT_ALBEDO + 1] + u[NB_OUT_ALBEDO + 2]) / 3.0f;
                         if (!isfinite(lv[4])) atomicOr(flag, NB_GUARD_OUTPUT);
-                        for (int o = 0; o < 8; ++o) g[o] = g[o] * y[o] * (1.0f - y[o]) * lp.loss_scale;
+                        for (int o = 0; o < 8; ++o) g[o] = nb_presigmoid_gradient(g[o], y[o]) * lp.loss_scale;
                     }
                 }
                 for (int o = 0; o < 16; ++o) sO[(row0 + lane) * kLdO + o] = __float2half_rn(o < 8 ? g[o] : 0.0f);
