@@ -13,7 +13,13 @@
 // eps is added to sqrt of the UNCORRECTED v (tcnn's folded form; PyTorch differs by sqrt(1-b2^t) on
 // eps). t is a per-parameter uint32 step counter, so a hash entry first touched late starts its own
 // bias correction at t = 1. The fp16 copy of w (the shaders' weights) is the caller's: it rounds w
-// after the update (CUDA: __float2half_rn in the same kernel; CPU: the model export).
+// after the update (CUDA: __float2half_rn in the same kernel; CPU: the model export); updates below half
+// an fp16 ulp accumulate in the fp32 master, and a master of magnitude >= 65520 has an infinite copy.
+// Range (float arithmetic, as tcnn): for |g| above sqrt(FLT_MAX / (1 - b2)) (5.8e20 at b2 = 0.999)
+// (1 - b2) g^2 overflows, v becomes inf and the parameter stops moving for good (w, m stay finite); the
+// trainers' gradients are many orders below that, and their guards skip a step with a non-finite gradient
+// before it gets here. For |g| below ~1e-21 (1 - b2) g^2 underflows to 0 and the step, lr_t m / eps, is
+// far below w's resolution.
 #ifndef NB_ADAM_UPDATE_H
 #define NB_ADAM_UPDATE_H
 
