@@ -1,7 +1,7 @@
 // nbvh render SCENE [--out FILE.png|.exr] [--width --height --spp --max-depth --seed] [--device]
 //                   [--camera ex,ey,ez,tx,ty,tz,fov] [--env FILE.hdr|.exr|none] [--exposure auto|STOPS]
 //                   [--stats FILE.json] [--explain]
-//                   [--model M.nbvh [--lod L] [--secondary-lod L] [--neural-path auto|scalar|coopmat]]
+//                   [--model M.nbvh [--lod L] [--secondary-lod coarsest|same|L] [--neural-path auto|scalar|coopmat]]
 //                   [--classical] [--neural GLOB] [--neural-roughness R] [--neural-metallic M]
 //                   [--neural-max-leaves N] [--neural-batched-rounds N] [--wave-pixels N]
 //                   [--texture-path auto|buffer|array]
@@ -41,7 +41,7 @@ namespace {
 struct RenderArgs {
     std::string scene, out = "render.png", device = "auto", camera, env, stats, exposure = "auto";
     std::optional<float> env_rotation; // degrees
-    std::string model, neural_path = "auto", neural_glob, texture_path = "auto";
+    std::string model, neural_path = "auto", neural_glob, texture_path = "auto", secondary_lod = "coarsest";
     render::RenderOptions options;
     bool explain = false;
 };
@@ -98,6 +98,7 @@ void run_render(const RenderArgs& a) {
     check_output_path(a.stats, "--stats", inputs);
     const std::optional<float> fixed_exposure = parse_exposure(a.exposure);
     const render::TexturePathRequest texture_path = render::parse_texture_path(a.texture_path);
+    const int32_t secondary_lod = parse_secondary_lod(a.secondary_lod);
     if (fixed_exposure && is_exr_path(a.out))
         log_warn("render: --exposure is ignored for EXR output (linear radiance, unscaled)");
     vk::ContextOptions copt;
@@ -106,6 +107,7 @@ void run_render(const RenderArgs& a) {
     lo.neural_glob = a.neural_glob;
     render::RenderOptions options = a.options;
     options.texture_path = texture_path;
+    options.neural.secondary_lod = secondary_lod;
     NeuralModel model;
     if (!a.model.empty()) model = load_model(a.model);
     // With a model (also for --classical: the same instances, from their triangles) its asset table
@@ -195,8 +197,9 @@ void add_render_command(CLI::App& app) {
                   "reference: the true scene (neural instances from their triangles and glTF materials)");
     cmd->add_option("--neural", args->neural_glob, "nodes whose name matches this glob are neural instances");
     cmd->add_option("--lod", args->options.neural.lod, "N-BVH level of detail of camera rays (0 = finest)");
-    cmd->add_option("--secondary-lod", args->options.neural.secondary_lod,
-                    "N-BVH level of detail after the first hit (default: --lod)");
+    cmd->add_option("--secondary-lod", args->secondary_lod,
+                    "N-BVH level of detail after the first hit: coarsest (default: the model's coarsest LoD, "
+                    "never finer than --lod; = --lod for a one-LoD model), same (as --lod) or 0..7");
     cmd->add_option("--neural-path", args->neural_path, "MLP implementation: auto, scalar or coopmat");
     cmd->add_option("--texture-path", args->texture_path,
                     "textures as one texel buffer (any device), an array of images (descriptor indexing), or "

@@ -1,5 +1,5 @@
 // nbvh view SCENE [--model M.nbvh] [--env FILE|none] [--width W --height H] [--device auto|gpu|cpu]
-//                 [--max-depth D] [--lod L] [--secondary-lod L] [--neural GLOB]
+//                 [--max-depth D] [--lod L] [--secondary-lod coarsest|same|L] [--neural GLOB]
 //                 [--screenshot FILE.png] [--frames N] [--hide-ui] [--script FILE]
 // The interactive viewer (app/viewer/): progressive path tracing in a window with a UI panel.
 // --frames N exits after N frames (headless tests under Xvfb); --screenshot saves the window then;
@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "app/commands.h"
+#include "app/render_args.h"
 #include "app/viewer/viewer.h"
 
 namespace nbvh::app {
@@ -25,16 +26,18 @@ void add_view_command(CLI::App& app) {
     cmd->add_option("--device", args->device, "Vulkan device: auto, gpu or cpu (lavapipe)");
     cmd->add_option("--max-depth", args->max_depth, "maximum path segments")->check(CLI::Range(1u, 256u));
     cmd->add_option("--lod", args->lod, "initial N-BVH level of detail (0 = finest)");
-    cmd->add_option("--secondary-lod", args->secondary_lod, "initial LoD after the first hit (-1: same as --lod)")
-        ->check(CLI::Range(-1, 1 << 20));
+    auto secondary_lod = std::make_shared<std::string>("coarsest");
+    cmd->add_option("--secondary-lod", *secondary_lod,
+                    "initial LoD after the first hit: coarsest (default), same (as --lod) or 0..7 (as nbvh render)");
     cmd->add_option("--screenshot", args->screenshot, "save the window content as PNG after --frames frames");
     auto* frames = cmd->add_option("--frames", args->frames, "exit after this many frames (default with --screenshot: 16)")
                        ->check(CLI::Range(1u, 1u << 20));
     cmd->add_option("--script", args->script, "run the commands of this file (app/viewer/script.h), then exit")
         ->excludes(frames);
     cmd->add_flag("--hide-ui", args->hide_ui, "start with the UI panel hidden (F1 toggles it)");
-    cmd->callback([args] {
+    cmd->callback([args, secondary_lod] {
         viewer::ViewerArgs a = *args;
+        a.secondary_lod = parse_secondary_lod(*secondary_lod);
         if (!a.screenshot.empty() && a.frames == 0 && a.script.empty()) a.frames = 16;
         viewer::run_viewer(a);
     });

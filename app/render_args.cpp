@@ -64,6 +64,13 @@ std::optional<float> parse_exposure(const std::string& text) {
     throw Error(strfmt("--exposure '%s': expected 'auto' or a number of stops in [-24, 24]", text.c_str()));
 }
 
+int32_t parse_secondary_lod(const std::string& text) {
+    if (text == "coarsest") return render::SECONDARY_LOD_COARSEST;
+    if (text == "same") return render::SECONDARY_LOD_SAME;
+    if (text.size() == 1 && text[0] >= '0' && text[0] <= '7') return text[0] - '0';
+    throw Error(strfmt("--secondary-lod '%s': expected 'coarsest', 'same' or a level of detail 0..7", text.c_str()));
+}
+
 BackendChoice parse_backend(const std::string& s) {
     if (s == "cpu") return BackendChoice::cpu;
     if (s == "cuda") return BackendChoice::cuda;

@@ -30,6 +30,9 @@ Camera choose_camera(const Scene& scene, const std::string& camera_arg, const re
 
 // --exposure: "auto" (nullopt) or a number of stops in [-24, 24]; throws nbvh::Error otherwise.
 std::optional<float> parse_exposure(const std::string& text);
+// --secondary-lod: "coarsest" (render::SECONDARY_LOD_COARSEST), "same" (as --lod) or a LoD index 0..7;
+// throws nbvh::Error otherwise.
+int32_t parse_secondary_lod(const std::string& text);
 // --backend: cpu, cuda or auto; throws nbvh::Error otherwise.
 BackendChoice parse_backend(const std::string& text);
 

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <string>
 
+#include "engine/render/neural_stage.h"
+
 namespace nbvh::viewer {
 
 struct ViewerArgs {
@@ -16,7 +18,7 @@ struct ViewerArgs {
     uint32_t width = 1280, height = 720; // window (and initial film) size
     uint32_t max_depth = 8;
     uint32_t lod = 0;
-    int32_t secondary_lod = -1;
+    int32_t secondary_lod = render::SECONDARY_LOD_COARSEST; // or SECONDARY_LOD_SAME or a LoD index
     std::string screenshot;       // PNG of the window content after `frames` frames
     uint32_t frames = 0;          // > 0: exit after this many frames (headless tests)
     bool hide_ui = false;

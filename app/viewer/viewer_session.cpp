@@ -75,6 +75,8 @@ void ViewerSession::set_model_info() {
     if (view_->model) {
         const int lods = int(std::max(1u, view_->model->lod_count));
         settings_.lod = std::min(settings_.lod, lods - 1);
+        // The renderer's choice made visible on the slider: the coarsest LoD (never finer than lod).
+        if (settings_.secondary_lod == render::SECONDARY_LOD_COARSEST) settings_.secondary_lod = std::max(settings_.lod, lods - 1);
         settings_.secondary_lod = std::min(settings_.secondary_lod, lods - 1);
     }
     if (!view_->node_loss && settings_.view == ViewMode::loss) settings_.view = ViewMode::image;

@@ -33,7 +33,7 @@ void validate(const NeuralRenderOptions& o, const Scene& scene) {
     if (o.model) {
         const uint32_t lods = std::max(1u, o.model->lod_count);
         if (o.lod >= lods) throw Error(strfmt("--lod %u: the model has %u level(s) of detail (0..%u)", o.lod, lods, lods - 1));
-        if (o.secondary_lod >= int32_t(lods))
+        if (o.secondary_lod < SECONDARY_LOD_COARSEST || o.secondary_lod >= int32_t(lods))
             throw Error(strfmt("--secondary-lod %d: the model has %u level(s) of detail (0..%u)", o.secondary_lod,
                                lods, lods - 1));
     }
@@ -161,7 +161,11 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     batched_ = std::min(needed, o.batched_rounds);
     params_.box = model_.box();
     params_.lod_primary = std::min(o.lod, model_.lod_count() - 1);
-    params_.lod_secondary = std::min(o.secondary_lod < 0 ? o.lod : uint32_t(o.secondary_lod), model_.lod_count() - 1);
+    const uint32_t coarsest = model_.lod_count() - 1;
+    const uint32_t secondary = o.secondary_lod == SECONDARY_LOD_COARSEST ? std::max(o.lod, coarsest)
+                               : o.secondary_lod < 0                     ? o.lod
+                                                                         : uint32_t(o.secondary_lod);
+    params_.lod_secondary = std::min(secondary, coarsest);
     params_.roughness = o.roughness < 0.0f ? -1.0f : o.roughness;
     params_.metallic = o.metallic < 0.0f ? -1.0f : o.metallic;
     params_.threshold = o.threshold;

@@ -27,12 +27,17 @@
 
 namespace nbvh::render {
 
+// NeuralRenderOptions::secondary_lod besides a LoD index.
+inline constexpr int32_t SECONDARY_LOD_SAME = -1;     // the camera rays' LoD
+inline constexpr int32_t SECONDARY_LOD_COARSEST = -2; // the model's coarsest LoD (never finer than lod)
+
 struct NeuralRenderOptions {
     const NeuralModel* model = nullptr; // hybrid render when set (and not classical)
     bool classical = false;             // reference: neural instances as triangles (the true scene)
     NeuralPath path = NeuralPath::automatic;
     uint32_t lod = 0;                   // N-BVH cut of camera rays (0 = finest)
-    int32_t secondary_lod = -1;         // cut after the first hit (-1: same as lod)
+    int32_t secondary_lod = SECONDARY_LOD_SAME; // cut after the first hit (SECONDARY_LOD_* or an index);
+                                                // the CLI's default is SECONDARY_LOD_COARSEST
     // Explicit overrides of the neural surfaces' material (< 0: the asset's glTF material). When set they
     // apply to the classical reference too, so both renders shade alike.
     float roughness = -1.0f;

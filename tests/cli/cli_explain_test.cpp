@@ -51,6 +51,31 @@ TEST(CliExplain, HybridRenderListsTheNeuralPasses) {
                                                  << o;
 }
 
+TEST(CliExplain, SecondaryRaysTakeTheCoarsestLodByDefault) {
+    // Default --secondary-lod coarsest: the model's coarsest cut after the first hit (issue 14; the study's
+    // "LoD 0, then 2 after the first hit" rows), never finer than --lod; 'same' and an index as asked.
+    struct Case {
+        std::vector<std::string> flags;
+        const char* expect;
+    };
+    const Case cases[] = {{{}, "camera rays 0, after the first hit 1 (the model has 2"},
+                          {{"--lod", "1"}, "camera rays 1, after the first hit 1 (the model has 2"},
+                          {{"--secondary-lod", "same"}, "camera rays 0, after the first hit 0 (the model has 2"},
+                          {{"--secondary-lod", "coarsest"}, "camera rays 0, after the first hit 1 (the model has 2"},
+                          {{"--lod", "1", "--secondary-lod", "0"}, "camera rays 1, after the first hit 0 (the model"}};
+    for (const Case& c : cases) {
+        std::vector<std::string> flags = {"--model", tiny_model().string()};
+        flags.insert(flags.end(), c.flags.begin(), c.flags.end());
+        const auto r = run_nbvh(explain(flags), 60.0);
+        ASSERT_EQ(r.exit_code, 0) << r.describe();
+        EXPECT_TRUE(has(r.out, c.expect)) << c.expect << "\n" << r.out;
+    }
+    for (const char* bad : {"finest", "-1", "8", "2"}) { // 2: the model has LoDs 0..1
+        const auto r = run_nbvh(explain({"--model", tiny_model().string(), "--secondary-lod", bad}), 60.0);
+        EXPECT_EQ(check_clean_error(r, {"--secondary-lod"}, false), "") << bad << "\n" << r.describe();
+    }
+}
+
 TEST(CliExplain, LeavesPerRoundComeFromTheRenderersStage) {
     // --neural-leaves-per-round reaches the renderer's stage (it was a hidden environment variable).
     const auto r = run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round", "2"}), 60.0);
