@@ -7,7 +7,10 @@
 // (post-sigmoid), what reference_network backward() and the CUDA backward take:
 //   L = w_vis * BCE(y0, t0) + w_depth * |y1 - t1| + w_normal * sum_i |N(y_i) - t_i| (i = 2..4)
 //       + w_albedo * sum_i (y_i - t_i)^2 / (y_i^2 + 0.01) (i = 5..7)
-//   BCE: p = clamp(y0, 1e-5, 1 - 1e-5), -(t log p + (1-t) log(1-p)), dL/dy0 = -(t - p)/(p - p^2)
+//   BCE: p = clamp(y0, 1e-5, 1 - 1e-5), -(t log p + (1-t) log(1-p)), dL/dy0 = -(t - p)/(p (1 - p))
+//   (the official code divides by p - p^2, which cancels near p = 1: 1e-5 relative at the clamp and
+//   3e-5 between host and device, measured on the H100; 1 - p is exact for p >= 1/2, so p (1 - p) is
+//   within a few ulps everywhere -- same function, rounding only)
 //        (evaluated at the clamped p, as tcnn: the gradient does not vanish in the clamped range, and
 //        stays finite at y = 0 and y = 1: |dL/dy0| <= ~1e5).
 //   L1: d/dy = sign(y - t) (0 when equal).
@@ -41,7 +44,7 @@ NB_FN float nb_loss_sign(float x) { return x > 0.0f ? 1.0f : (x < 0.0f ? -1.0f :
 // Each term unweighted: returns its value, writes dvalue/dy.
 NB_FN float nb_loss_bce(float y, float t, NB_OUT(float) d) {
     const float p = fminf(fmaxf(y, NB_BCE_CLAMP), 1.0f - NB_BCE_CLAMP);
-    d = -(t - p) / (p - p * p);
+    d = -(t - p) / (p * (1.0f - p));
     return -(t * logf(p) + (1.0f - t) * logf(1.0f - p));
 }
 NB_FN float nb_loss_l1(float y, float t, NB_OUT(float) d) {
