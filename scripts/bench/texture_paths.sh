@@ -33,6 +33,8 @@ if [ -d "$DIR/layer" ]; then
   cp "$DIR"/layer/*.json "$T/layer/"
   for f in "$DIR"/layer/*.so*; do unpack "$f"; mv "$T/$(basename "${f%.xz}")" "$T/layer/"; done
   export VK_LAYER_PATH=$T/layer
+  # The manifest names the library without a path: the loader finds it through the dynamic linker.
+  export LD_LIBRARY_PATH="$T/layer${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 fi
 S=$OUT/summary.txt
 (nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null || echo "no nvidia-smi") > "$S"
@@ -67,8 +69,11 @@ VAL=unavailable
 if [ -n "${VK_LAYER_PATH:-}" ]; then
   NBVH_VALIDATION=1 "$NBVH" render "$SCENE" --texture-path array --width 480 --height 270 --spp 2 --max-depth 4 \
     --out "$T/validation.png" > "$T/validation.txt" 2>&1
+  RC=$?
   VAL=$(grep -c "vulkan validation" "$T/validation.txt")
   grep -q "not installed" "$T/validation.txt" && VAL=unavailable
+  # A render that did not finish counted nothing: say so instead of reporting 0 messages.
+  [ "$RC" -eq 0 ] || VAL="render failed (exit $RC): $(tail -1 "$T/validation.txt")"
 fi
 echo "validation messages, array path on Chess (480x270, 2 spp): $VAL" >> "$S"
 
