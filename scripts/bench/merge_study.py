@@ -1,0 +1,75 @@
+#!/usr/bin/env python3
+"""Joins `nbvh study` runs of one scene that swept different configurations into one study.json
+(issue 11: one GPU call is limited to 10 minutes, so a 3x3 sweep may come back in parts, e.g. nodes
+1000,2395 in one call and NODES=8000 in the next).
+
+usage: merge_study.py OUT.json PART.json [PART.json ...]
+
+The parts must describe the same study: scene, settings and cameras (views, exposures and noise floors:
+the same reference and floor renders) equal, else it exits non-zero naming the difference. Configurations
+are renumbered in part order. The result keeps each part's commit and command (`parts`), joins the
+commits in `commit` ('A (configs 1-6) + B (configs 7-9)') so that the plots' captions name them, and is
+complete when the joined configurations cover the whole nodes x hash grid they span.
+"""
+import json
+import sys
+
+
+def fail(msg):
+    sys.exit(f"merge_study.py: {msg}")
+
+
+def main(argv):
+    if len(argv) < 3:
+        fail("usage: merge_study.py OUT.json PART.json [PART.json ...]")
+    out_path, paths = argv[1], argv[2:]
+    parts = []
+    for p in paths:
+        try:
+            with open(p) as f:
+                parts.append(json.load(f))
+        except (OSError, ValueError) as e:
+            fail(f"{p}: {e}")
+    base = parts[0]
+    for p, s in zip(paths[1:], parts[1:]):
+        for key in ("scene", "settings", "device", "flip_metric"):
+            if s.get(key) != base.get(key):
+                fail(f"{p}: '{key}' differs from {paths[0]}'s")
+        if len(s["cameras"]) != len(base["cameras"]):
+            fail(f"{p}: {len(s['cameras'])} cameras, {paths[0]} has {len(base['cameras'])}")
+        for a, b in zip(base["cameras"], s["cameras"]):
+            for key in ("view", "exposure_stops", "noise_floor"):
+                if a.get(key) != b.get(key):
+                    fail(f"{p}: camera {a['camera']} '{key}' differs ({b.get(key)} vs {a.get(key)}): "
+                         "not the same reference")
+    merged = dict(base)
+    merged["configs"], merged["rows"], merged["mean_rows"], merged["parts"], commits = [], [], [], [], []
+    offset = 0
+    for p, s in zip(paths, parts):
+        remap = {c["config"]: offset + i for i, c in enumerate(s["configs"])}
+        for c in s["configs"]:
+            merged["configs"].append(dict(c, config=remap[c["config"]]))
+        for key in ("rows", "mean_rows"):
+            merged[key] += [dict(r, config=remap.get(r["config"], r["config"])) for r in s[key]]
+        first, last = offset + 1, offset + len(s["configs"])
+        commits.append(f"{s['commit']} (configs {first}-{last})")
+        merged["parts"].append({"file": p, "commit": s["commit"], "command_line": s["command_line"],
+                                "started_utc": s["started_utc"], "configs": [first, last],
+                                "stop_reason": s.get("stop_reason", "")})
+        offset += len(s["configs"])
+    merged["commit"] = " + ".join(commits)
+    merged["command_line"] = " ; ".join(s["command_line"] for s in parts)
+    merged["configs_done"] = sum(s.get("configs_done", len(s["configs"])) for s in parts)
+    merged["configs_planned"] = merged["configs_done"]
+    # Complete when the joined configurations cover the whole nodes x hash grid they span.
+    grid = {(c["nodes_target"], c["hash_log2"]) for c in merged["configs"]}
+    merged["complete"] = len(grid) == len({n for n, _ in grid}) * len({h for _, h in grid})
+    merged["stop_reason"] = ""
+    merged["written_utc"] = max(s["written_utc"] for s in parts)
+    with open(out_path, "w") as f:
+        json.dump(merged, f, indent=1)
+    print(f"wrote {out_path}: {offset} configurations from {len(parts)} parts")
+
+
+if __name__ == "__main__":
+    main(sys.argv)
