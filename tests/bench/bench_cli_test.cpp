@@ -22,10 +22,13 @@ std::vector<std::string> tiny_bench(const fs::path& model, const fs::path& json)
             "--spp", "1", "--repeat", "1", "--json", json.string()};
 }
 
-// A tiny 2-LoD model of the default scene (a few seconds on the CPU backend), trained once.
+// A tiny 2-LoD model of the default scene (a few seconds on the CPU backend), trained once per test
+// process; the folder is named after the test (ctest runs the tests as parallel processes and temp_dir
+// empties the folder it returns).
 const fs::path& tiny_model() {
     static const fs::path model = [] {
-        const fs::path dir = nbvh::test::temp_dir("bench_model");
+        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        const fs::path dir = nbvh::test::temp_dir("bench_model_" + test);
         const fs::path m = dir / "tiny.nbvh";
         const auto r = run_nbvh({"train", "default", "--backend", "cpu", "--steps", "20", "--batch", "256", "--nodes",
                                  "63", "--hash-log2", "12", "--lods", "2", "--threads", "2", "--out", m.string()},

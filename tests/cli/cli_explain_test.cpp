@@ -11,10 +11,13 @@ namespace fs = std::filesystem;
 using nbvh::test::check_clean_error;
 using nbvh::test::run_nbvh;
 
-// A tiny 2-LoD model of the default scene's rope knot (about a second on the CPU backend), trained once.
+// A tiny 2-LoD model of the default scene's rope knot (about a second on the CPU backend), trained once
+// per test process. ctest runs each test in its own process, in parallel: the folder is named after the
+// test, since temp_dir empties it (one shared folder had one test's model deleted under another).
 const fs::path& tiny_model() {
     static const fs::path model = [] {
-        const fs::path m = nbvh::test::temp_dir("cli_explain_model") / "tiny.nbvh";
+        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        const fs::path m = nbvh::test::temp_dir("cli_explain_model_" + test) / "tiny.nbvh";
         const auto r =
             run_nbvh({"train", "default", "--backend", "cpu", "--steps", "20", "--batch", "256", "--nodes",
                       "63", "--hash-log2", "12", "--lods", "2", "--threads", "2", "--out", m.string()},
