@@ -16,6 +16,18 @@ bool texture_exists(const Scene& scene, const TextureRef& ref) {
            scene.textures[size_t(ref.texture)].width > 0 && scene.textures[size_t(ref.texture)].height > 0;
 }
 
+// Whether a transmissive material can have metallic < 1 somewhere: its factor, or a metallic-roughness
+// texture (metallic = factor x B) with a texel below 255. Chess's glass pawn tops have metallicFactor 1
+// (the glTF default) and metallic from the texture: the factor alone dropped their transmission.
+bool metallic_below_one(const Scene& scene, const Material& m) {
+    if (m.metallic < 1.0f) return true;
+    if (!texture_exists(scene, m.metallic_roughness_tex)) return false;
+    const std::vector<uint8_t>& px = scene.textures[size_t(m.metallic_roughness_tex.texture)].rgba8;
+    for (size_t i = 2; i < px.size(); i += 4)
+        if (px[i] < 255) return true;
+    return false;
+}
+
 std::string neural_rounds_text(const NeuralPlan& n, const char* traverse, const char* what) {
     std::string s;
     s += strfmt("    %-26s op 0: %s, queues (ray, leaf) pairs (indirect)\n", traverse, what);
@@ -55,7 +67,7 @@ SceneFeatures derive_features(const Scene& scene, const Environment& environment
         if (m.emissive.x > 0.0f || m.emissive.y > 0.0f || m.emissive.z > 0.0f) f.emission = true;
         if (m.alpha_mode != AlphaMode::opaque) f.alpha_mask = true;
         if (!m.double_sided) f.single_sided = true;
-        if (m.transmission > 0.0f && m.metallic < 1.0f) f.transmission = true;
+        if (m.transmission > 0.0f && metallic_below_one(scene, m)) f.transmission = true;
     }
     // Without a model (or with --classical) neural instances render from their triangles.
     if (neural.model && !neural.classical)
