@@ -81,7 +81,7 @@ TEST(GltfRealScenes, SmithsonianGetsGeneratedTangents) {
     EXPECT_EQ(g.meshes[0].triangle_count(), 100000u);
 }
 
-// 28 MB: the only test that loads it.
+// 28 MB: loaded here and by FeatureForce.ChessGlassPawnTopsTransmitInTheirOwnRender (tests/render).
 TEST(GltfRealScenes, ChessInstancingAndNeuralScene) {
     NBVH_REQUIRE_SHARED();
     Scene s = load_quiet("abeautifulgame/abeautifulgame.glb");
