@@ -2,24 +2,48 @@
 // renderer (engine/render/texture_path.h):
 //   default:          the RGBA8 texel buffer (layout: GpuTextureInfo in shared/scene_gpu.h), bilinear in
 //                     the shader;
-//   NB_TEXTURE_ARRAY: one sampler2D per texture (binding NB_BIND_TEXELS), the sampler's bilinear filter.
-// Both: bilinear on the raw 8-bit values, REPEAT wrapping, texel centres at half-integers, v = 0 at the
-// top row (glTF), one level (no mip maps), non-linearised values (the caller decodes sRGB).
+//   NB_TEXTURE_ARRAY: one sampler2D per texture (binding NB_BIND_TEXELS), four texelFetch per lookup.
+// Both: the same bilinear footprint and weights (nb_bilinear_footprint) on the raw 8-bit values, REPEAT
+// wrapping, texel centres at half-integers, v = 0 at the top row (glTF), one level (no mip maps),
+// non-linearised values (the caller decodes sRGB).
 #ifndef NB_TEXTURES_GLSL
 #define NB_TEXTURES_GLSL
 #include "lib/bindings.glsl"
 #include "shared/sampling.h"
 
+// The bilinear footprint of uv in a w x h texture, the same for both paths: texels x0/x1, y0/y1 (REPEAT-
+// wrapped) and the weights f of x1/y1. The uv is wrapped first, so huge coordinates cannot overflow.
+void nb_bilinear_footprint(vec2 uv, int w, int h, out ivec2 lo, out ivec2 hi, out vec2 f) {
+    uv = uv - floor(uv);
+    vec2 p = uv * vec2(float(w), float(h)) - 0.5f;
+    f = p - floor(p);
+    int x = int(floor(p.x));
+    int y = int(floor(p.y));
+    lo = ivec2(((x % w) + w) % w, ((y % h) + h) % h);
+    hi = ivec2(((x + 1) % w + w) % w, ((y + 1) % h + h) % h);
+}
+
 #ifdef NB_TEXTURE_ARRAY
 
 // One image per glTF texture (RGBA8 UNORM: raw values, sRGB decoded after filtering as the buffer path
-// does), a bilinear REPEAT sampler, one level (engine/render/texture_array.h).
+// does), one level (engine/render/texture_array.h).
 layout(set = 0, binding = NB_BIND_TEXELS) uniform sampler2D texture_images[];
 
-// Bilinear lookup; returns the raw (non-linearised) texel values. The wrapped uv (as the buffer path
-// wraps it) keeps huge coordinates as precise as there.
+// Bilinear lookup; returns the raw (non-linearised) texel values. Four texelFetch and the shader's own
+// weights, not the sampler's filter: the hardware filter quantises its weights (8 bits on NVIDIA) and,
+// measured on the H100, disagreed with the buffer path by up to 0.16 of the emissive scale along a REPEAT
+// seam row (TextureArrayGpu.DirectLookupsAgreeWithinTheFilterPrecision); with the shared footprint both
+// paths give the same value.
 vec4 nb_sample_texture(int texture, vec2 uv) {
-    return textureLod(texture_images[nonuniformEXT(texture)], uv - floor(uv), 0.0f);
+    ivec2 size = textureSize(texture_images[nonuniformEXT(texture)], 0);
+    ivec2 lo, hi;
+    vec2 f;
+    nb_bilinear_footprint(uv, size.x, size.y, lo, hi, f);
+    vec4 a = texelFetch(texture_images[nonuniformEXT(texture)], ivec2(lo.x, lo.y), 0);
+    vec4 b = texelFetch(texture_images[nonuniformEXT(texture)], ivec2(hi.x, lo.y), 0);
+    vec4 c = texelFetch(texture_images[nonuniformEXT(texture)], ivec2(lo.x, hi.y), 0);
+    vec4 d = texelFetch(texture_images[nonuniformEXT(texture)], ivec2(hi.x, hi.y), 0);
+    return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
 }
 
 #else
@@ -28,24 +52,17 @@ vec4 nb_sample_texture(int texture, vec2 uv) {
 layout(set = 0, binding = NB_BIND_TEXELS, scalar) readonly buffer TexelBuffer { uint texels[]; };
 
 vec4 nb_texel(GpuTextureInfo ti, int x, int y) {
-    int w = int(ti.width);
-    int h = int(ti.height);
-    x = ((x % w) + w) % w;
-    y = ((y % h) + h) % h;
     return unpackUnorm4x8(texels[ti.offset + uint(y) * ti.width + uint(x)]);
 }
 
 // Bilinear lookup; returns the raw (non-linearised) texel values.
 vec4 nb_sample_texture(int texture, vec2 uv) {
     GpuTextureInfo ti = texture_infos[texture];
-    // Keep the coordinates bounded before scaling so huge uvs cannot overflow the int conversion.
-    uv = uv - floor(uv);
-    vec2 p = uv * vec2(float(ti.width), float(ti.height)) - 0.5f;
-    vec2 f = p - floor(p);
-    int x = int(floor(p.x));
-    int y = int(floor(p.y));
-    vec4 a = nb_texel(ti, x, y), b = nb_texel(ti, x + 1, y);
-    vec4 c = nb_texel(ti, x, y + 1), d = nb_texel(ti, x + 1, y + 1);
+    ivec2 lo, hi;
+    vec2 f;
+    nb_bilinear_footprint(uv, int(ti.width), int(ti.height), lo, hi, f);
+    vec4 a = nb_texel(ti, lo.x, lo.y), b = nb_texel(ti, hi.x, lo.y);
+    vec4 c = nb_texel(ti, lo.x, hi.y), d = nb_texel(ti, hi.x, hi.y);
     return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
 }
 
