@@ -9,8 +9,9 @@
 namespace nbvh::render {
 
 TextureArray::TextureArray(const vk::Context& ctx, const std::vector<Texture>& textures) {
-    // Raw 8-bit values (UNORM, not SRGB): the sampler filters them as the buffer path does and the shader
-    // decodes sRGB after filtering (material.glsl).
+    // Raw 8-bit values (UNORM, not SRGB): the shader reads four texels with texelFetch and filters them
+    // with the buffer path's footprint and weights (lib/textures.glsl), then decodes sRGB (material.glsl).
+    // The sampler only completes the combined image sampler; its filter is not used.
     static const uint8_t white[4] = {255, 255, 255, 255};
     const size_t n = std::max<size_t>(textures.size(), 1);
     images_.reserve(n);

@@ -1,6 +1,7 @@
 // The texture-array path's device side (texture_path.h): one RGBA8 UNORM VkImage per glTF texture (full
-// size, one level; an invalid texture becomes 1x1 white as in the texel buffer) and one bilinear REPEAT
-// sampler, bound as the `sampler2D texture_images[]` array of binding NB_BIND_TEXELS.
+// size, one level; an invalid texture becomes 1x1 white as in the texel buffer) and one sampler, bound as
+// the `sampler2D texture_images[]` array of binding NB_BIND_TEXELS (read with texelFetch: the shader
+// filters, lib/textures.glsl).
 #pragma once
 #include <cstdint>
 #include <vector>
