@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <map>
 
 #include "engine/core/error.h"
@@ -195,6 +196,8 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     }
     make_timer();
     cmd_ = vk::CommandBuffer(ctx_, "wavefront");
+    counter_readback_ = vk::Buffer(ctx_, sizeof(GpuQueueCounters) + sizeof(GpuNeuralCounters), vk::MemoryKind::host, 0,
+                                   "counter readback");
 }
 
 // Another model for the same scene: the neural instances' records (asset index, atlas transforms) are
@@ -391,11 +394,23 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
     // wrapped differences summed in 64 bits.
     uint64_t totals[7] = {0, 0, 0, 0, 0, 0, 0};
     uint32_t last[7] = {0, 0, 0, 0, 0, 0, 0};
+    // The counters are copied into counter_readback_ at the end of each submission (no extra round trip).
+    auto record_counter_copy = [&] {
+        cmd_.barrier(vk::Barrier::compute_to_transfer);
+        cmd_.copy(buffers_[NB_BIND_COUNTERS], counter_readback_, sizeof(GpuQueueCounters));
+        if (neural_)
+            cmd_.copy(buffers_[NB_BIND_NEURAL_COUNTERS], counter_readback_, sizeof(GpuNeuralCounters), 0,
+                      sizeof(GpuQueueCounters));
+        cmd_.barrier(vk::Barrier::compute_to_host);
+    };
     auto tally = [&] {
-        const GpuQueueCounters c = buffers_[NB_BIND_COUNTERS].download<GpuQueueCounters>(1)[0];
+        const char* mapped = static_cast<const char*>(counter_readback_.mapped());
+        GpuQueueCounters c;
+        std::memcpy(&c, mapped, sizeof(c));
         uint32_t now[7] = {c.rays_primary, c.rays_secondary, c.rays_shadow, c.nonfinite_samples, 0, 0, 0};
         if (neural_) {
-            const GpuNeuralCounters nc = buffers_[NB_BIND_NEURAL_COUNTERS].download<GpuNeuralCounters>(1)[0];
+            GpuNeuralCounters nc;
+            std::memcpy(&nc, mapped + sizeof(GpuQueueCounters), sizeof(nc));
             now[4] = nc.queries_total;
             now[5] = nc.rounds;
             now[6] = nc.leaf_cap_rays;
@@ -412,6 +427,7 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
             cmd_.begin();
             if (timer_.available()) timer_.reset(cmd_.handle());
             record_sample_wave(cmd_, sample, offset, count);
+            record_counter_copy();
             cmd_.submit_and_wait();
             collect();
             tally();

@@ -173,6 +173,9 @@ private:
     uint64_t live_updates_ = 0, model_swaps_ = 0;
     vk::GpuTimer timer_;
     vk::CommandBuffer cmd_;
+    // Host-visible copy of the queue and neural counters, written by each sample's own submission
+    // (two blocking downloads with fresh staging buffers per sample before).
+    vk::Buffer counter_readback_;
 };
 
 } // namespace nbvh::render
