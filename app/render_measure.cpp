@@ -13,19 +13,6 @@ render::RenderStats median_render_stats(render::WavefrontRenderer& renderer, uin
     return runs[runs.size() / 2];
 }
 
-Image as_png_pixels(const Image& linear, float exposure_stops) {
-    PngEncode enc;
-    enc.tone_map = ToneMap::aces;
-    enc.exposure = exposure_stops;
-    int channels = 0;
-    const std::vector<uint8_t> px = to_srgb8(linear, enc, &channels);
-    Image out(linear.width, linear.height, 3);
-    for (size_t i = 0; i < linear.pixel_count(); ++i)
-        for (int c = 0; c < 3; ++c)
-            out.data[i * 3 + c] = srgb_to_linear(float(px[i * size_t(channels) + c]) / 255.0f);
-    return out;
-}
-
 nlohmann::json pass_ms_json(const render::RenderStats& s) {
     nlohmann::json passes = nlohmann::json::object();
     for (const auto& [name, ms] : s.pass_ms) passes[name] = ms;

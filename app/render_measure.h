@@ -16,10 +16,6 @@ namespace nbvh::app {
 // GPU time. The renderer keeps its options (apply() them first).
 render::RenderStats median_render_stats(render::WavefrontRenderer& renderer, uint32_t repeat);
 
-// `linear` as a PNG of `nbvh render` holds it (exposure in stops, ACES tone map, 8-bit sRGB), decoded
-// back to linear [0,1] RGB: what flip_ldr expects.
-Image as_png_pixels(const Image& linear, float exposure_stops = 0.0f);
-
 // Per-pass GPU milliseconds of `s` as a JSON object.
 nlohmann::json pass_ms_json(const render::RenderStats& s);
 

@@ -9,19 +9,6 @@
 
 namespace nbvh::viewer {
 
-Image display_pixels(const Image& linear, float exposure) {
-    PngEncode enc;
-    enc.exposure = exposure;
-    enc.tone_map = ToneMap::aces; // as the window (FilmSource) and nbvh render's PNGs
-    int channels = 0;
-    const std::vector<uint8_t> px = to_srgb8(linear, enc, &channels);
-    Image out(linear.width, linear.height, 3);
-    for (size_t i = 0; i < linear.pixel_count(); ++i)
-        for (int c = 0; c < 3; ++c)
-            out.data[i * 3 + size_t(c)] = srgb_to_linear(float(px[i * size_t(channels) + size_t(c)]) / 255.0f);
-    return out;
-}
-
 CompareResult compare_images(const Image& test, const Image& reference, ViewMode mode, float gain) {
     NBVH_CHECK(test.width == reference.width && test.height == reference.height && test.channels == 3 &&
                reference.channels == 3);
@@ -101,7 +88,7 @@ void Comparer::start(const render::WavefrontRenderer& test, const render::Wavefr
     const ViewMode mode = s.view;
     const float exposure = s.exposure, gain = s.gain;
     job_ = std::async(std::launch::async, [a = std::move(a), b = std::move(b), sa, sb, mode, exposure, gain] {
-        CompareResult r = compare_images(display_pixels(a, exposure), display_pixels(b, exposure), mode, gain);
+        CompareResult r = compare_images(as_png_pixels(a, exposure), as_png_pixels(b, exposure), mode, gain);
         r.test_samples = sa;
         r.reference_samples = sb;
         return r;

@@ -26,8 +26,6 @@ struct CompareResult {
     ViewMode mode = ViewMode::flip;   // what rgba8 shows (difference or flip)
 };
 
-// The display bytes of a linear film (as the window and the PNGs), decoded to linear [0,1] for FLIP.
-Image display_pixels(const Image& linear, float exposure);
 // Pure: the compare image of two display-pixel images of one size (difference: |a - b| in sRGB, x gain;
 // flip: the magma heat map) and the means.
 CompareResult compare_images(const Image& test, const Image& reference, ViewMode mode, float gain);

@@ -184,6 +184,19 @@ std::vector<uint8_t> to_srgb8(const Image& img, const PngEncode& enc, int* out_c
     return out;
 }
 
+Image as_png_pixels(const Image& linear, float exposure_stops) {
+    PngEncode enc;
+    enc.tone_map = ToneMap::aces;
+    enc.exposure = exposure_stops;
+    int channels = 0;
+    const std::vector<uint8_t> px = to_srgb8(linear, enc, &channels);
+    Image out(linear.width, linear.height, 3);
+    for (size_t i = 0; i < linear.pixel_count(); ++i)
+        for (int c = 0; c < 3; ++c)
+            out.data[i * 3 + size_t(c)] = srgb_to_linear(float(px[i * size_t(channels) + size_t(c)]) / 255.0f);
+    return out;
+}
+
 void save_png_8bit(const std::string& path, int width, int height, int channels, const uint8_t* pixels) {
     NBVH_CHECK(width > 0 && height > 0 && channels >= 1 && channels <= 4);
     write_atomically(path, "PNG", [&](const std::string& tmp) {

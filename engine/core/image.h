@@ -59,6 +59,9 @@ bool is_png_path(const std::string& path);
 // Encodes to 8-bit sRGB (3 or 4 channels per pixel per `enc.keep_alpha`), non-finite values -> 0.
 std::vector<uint8_t> to_srgb8(const Image& img, const PngEncode& enc, int* out_channels = nullptr);
 void save_png(const std::string& path, const Image& img, const PngEncode& enc = {});
+// `linear` as a PNG of `nbvh render` holds it (exposure in stops, ACES tone map, 8-bit sRGB), decoded back
+// to linear [0,1] RGB: what flip_ldr compares (`nbvh flip a.png b.png`), and what the viewer shows.
+Image as_png_pixels(const Image& linear, float exposure_stops = 0.0f);
 // Writes already-encoded 8-bit pixels (channels 1..4). Used for heatmaps (colour maps are sRGB).
 void save_png_8bit(const std::string& path, int width, int height, int channels, const uint8_t* pixels);
 // Linear float EXR (RGB or RGBA as the image has; 1-channel is written as Y). half=true stores fp16.

@@ -16,13 +16,8 @@
 // ray-parameter units, 0.0142 / 0.0197 / 0.0129 at 1e-1 / 1e-2 / 1e-4 (queries +17 % at 1e-1) before
 // shared/neural_query.h nb_decode_depth took the direction's length.
 #include "assets/procedural_mesh.h"
-#include "engine/bvh/scene_accel.h"
-#include "engine/core/exposure.h"
-#include "engine/core/flip.h"
-#include "engine/core/image.h"
 #include "engine/neural/asset_table.h"
 #include "engine/render/wavefront.h"
-#include "engine/scene/camera.h"
 #include "engine/scene/environment.h"
 #include "tests/render/scaled_scene.h"
 #include "trainer/model_export.h"
@@ -32,7 +27,6 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include <cmath>
 #include <cstdio>
 
 using namespace nbvh;
@@ -91,42 +85,18 @@ const NeuralModel& trained_model() {
     return *model;
 }
 
-struct Rendered {
-    Image image;
-    RenderStats stats;
-    int validation = 0;
-};
+using test::ScaledRender;
 
-Rendered render_hybrid(const Scene& scene, uint32_t seed) {
-    vk::ContextOptions co;
-    co.device = vk::DeviceChoice::cpu;
-    co.validation = true;
-    vk::Context ctx(co);
-    const SceneAccel accel = build_scene_accel(scene);
+ScaledRender render_hybrid(const Scene& scene, uint32_t seed) {
     RenderOptions o;
-    o.width = 64;
-    o.height = 48;
     o.spp = 4;
     o.max_depth = 3;
     o.seed = seed;
     o.neural.path = NeuralPath::scalar;
     o.neural.model = &trained_model();
-    WavefrontRenderer r(ctx, scene, accel, default_sky(), auto_frame(scene, 64.0f / 48.0f), o);
-    EXPECT_TRUE(r.hybrid());
-    RenderResult res = r.render();
-    return {std::move(res.image), res.stats, ctx.validation_message_count()};
-}
-
-Image display(const Image& linear, float stops) {
-    PngEncode enc;
-    enc.tone_map = ToneMap::aces;
-    enc.exposure = stops;
-    int channels = 0;
-    const std::vector<uint8_t> px = to_srgb8(linear, enc, &channels);
-    Image out(linear.width, linear.height, 3);
-    for (size_t i = 0; i < linear.pixel_count(); ++i)
-        for (int c = 0; c < 3; ++c) out.data[i * 3 + c] = srgb_to_linear(float(px[i * size_t(channels) + c]) / 255.0f);
-    return out;
+    ScaledRender r = test::render_scaled(scene, default_sky(), o);
+    EXPECT_GT(r.stats.neural_queries, 0u) << "the render must be hybrid";
+    return r;
 }
 
 } // namespace
@@ -134,36 +104,17 @@ Image display(const Image& linear, float stops) {
 TEST(ScaleHybrid, EveryScaleMatchesOneMetre) {
     Scene base = make_scene();
     bind_model_to_scene(base, trained_model(), "scale.nbvh");
-    const Rendered ref = render_hybrid(base, 3);
-    const Rendered other = render_hybrid(base, 4);
-    EXPECT_EQ(ref.validation, 0);
-    ASSERT_GT(ref.stats.neural_queries, 0u);
-    const float stops = auto_exposure(ref.image).stops;
-    const Image ref_px = display(ref.image, stops);
-    const double floor = flip_ldr(ref_px, display(other.image, stops)).mean;
-    std::printf("hybrid noise floor (1 m, other seed): %.4f\n", floor);
-    ASSERT_GT(floor, 0.01) << "a floor of nothing would make the bound meaningless";
-    struct Case {
-        const char* name;
-        float scale;
-        glm::vec3 offset;
-    };
-    const Case cases[] = {{"1e-1 (40 cm) at the origin", 1.0e-1f, glm::vec3(0.0f)},
-                          {"1e-2 (4 cm) at the origin", 1.0e-2f, glm::vec3(0.0f)},
-                          {"1e-4 (0.4 mm) at the origin", 1.0e-4f, glm::vec3(0.0f)},
-                          {"1e4 (40 km) at the origin", 1.0e4f, glm::vec3(0.0f)},
-                          {"1e4 (40 km), 3000 km away", 1.0e4f, glm::vec3(2.0e6f, 0.0f, -2.2e6f)}};
-    for (const Case& c : cases) {
-        SCOPED_TRACE(c.name);
-        const Rendered r = render_hybrid(test::scaled_scene(base, c.scale, c.offset), 3);
-        EXPECT_EQ(r.validation, 0);
-        EXPECT_EQ(r.stats.nonfinite_pixels, 0u);
-        EXPECT_EQ(r.stats.nonfinite_samples, 0u);
-        EXPECT_GT(r.stats.neural_queries, 0u);
-        const double flip = flip_ldr(ref_px, display(r.image, stops)).mean;
-        std::printf("%-30s FLIP vs 1 m hybrid %.4f (bound %.4f), queries %llu vs %llu\n", c.name, flip,
-                    FRACTION_OF_FLOOR * floor, (unsigned long long)r.stats.neural_queries,
-                    (unsigned long long)ref.stats.neural_queries);
-        EXPECT_LE(flip, FRACTION_OF_FLOOR * floor);
-    }
+    const test::ScaleCase cases[] = {{"1e-1 (40 cm) at the origin", 1.0e-1f, glm::vec3(0.0f)},
+                                     {"1e-2 (4 cm) at the origin", 1.0e-2f, glm::vec3(0.0f)},
+                                     {"1e-4 (0.4 mm) at the origin", 1.0e-4f, glm::vec3(0.0f)},
+                                     {"1e4 (40 km) at the origin", 1.0e4f, glm::vec3(0.0f)},
+                                     {"1e4 (40 km), 3000 km away", 1.0e4f, glm::vec3(2.0e6f, 0.0f, -2.2e6f)}};
+    test::expect_every_scale_matches(base, cases, 3, FRACTION_OF_FLOOR, render_hybrid,
+                                     [](const ScaledRender& ref, const ScaledRender& r) {
+                                         ASSERT_GT(ref.stats.neural_queries, 0u);
+                                         EXPECT_GT(r.stats.neural_queries, 0u);
+                                         std::printf("  neural queries %llu vs %llu at 1 m\n",
+                                                     (unsigned long long)r.stats.neural_queries,
+                                                     (unsigned long long)ref.stats.neural_queries);
+                                     });
 }

@@ -72,10 +72,10 @@ TEST(ViewerCompare, DifferenceAndFlipLightUpWhereTheImagesDiffer) {
         for (int c = 0; c < 3; ++c) ASSERT_EQ(channel(f.rgba8[i], c), heat[i * 3 + size_t(c)]);
 }
 
-TEST(ViewerCompare, DisplayPixelsAreThePngBytesDecoded) {
+TEST(ViewerCompare, PngPixelsAreThePngBytesDecoded) {
     Image film(5, 2, 4);
     for (size_t i = 0; i < film.data.size(); ++i) film.data[i] = float(i % 7) * 0.37f;
-    const Image px = display_pixels(film, 1.0f);
+    const Image px = as_png_pixels(film, 1.0f);
     PngEncode enc;
     enc.exposure = 1.0f;
     enc.tone_map = ToneMap::aces;
