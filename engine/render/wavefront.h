@@ -137,14 +137,16 @@ public:
     std::vector<TraceHit> trace(const std::vector<glm::vec3>& origins, const std::vector<glm::vec3>& dirs, float tmin = 0.0f);
 
 private:
-    GpuPassConstants constants(uint32_t queue, uint32_t depth, uint32_t sample, uint32_t offset, uint32_t count,
-                               uint32_t mode) const;
+    // One wave: `samples` samples (from `sample`) of the pixels [offset, offset + count), one path each.
+    struct Wave {
+        uint32_t sample = 0, samples = 1, offset = 0, count = 0;
+    };
+    GpuPassConstants constants(uint32_t queue, uint32_t depth, const Wave& w, uint32_t mode) const;
     enum class Dispatch { items, single, indirect_rays, indirect_shadow, indirect_pending };
     void record_pass(vk::CommandBuffer& cmd, size_t pass, const GpuPassConstants& pc, Dispatch dispatch,
                      uint64_t items = 0);
-    void record_sample_wave(vk::CommandBuffer& cmd, uint32_t sample, uint32_t offset, uint32_t count);
-    void record_neural_rounds(vk::CommandBuffer& cmd, size_t traverse_pass, uint32_t q, uint32_t depth, uint32_t sample,
-                              uint32_t offset, uint32_t count);
+    void record_sample_wave(vk::CommandBuffer& cmd, const Wave& w);
+    void record_neural_rounds(vk::CommandBuffer& cmd, size_t traverse_pass, uint32_t q, uint32_t depth, const Wave& w);
     // Samples [first, first + count) into the film (cleared when first == 0), then resolve + read back.
     RenderResult render_samples(uint32_t first, uint32_t count, bool read_back = true);
 
@@ -161,6 +163,8 @@ private:
     TextureArray texture_array_; // the texture-array path's images (texture_plan_.path == array)
     GpuFrameParams params_{};
     uint32_t capacity_ = 0;
+    uint32_t wave_samples_ = 1;           // samples per wave of a one-wave image (constructor)
+    uint32_t samples_per_submission_ = 1; // make_timer
     uint32_t accumulated_ = 0; // samples per pixel in the film (progressive rendering)
 
     std::vector<vk::Buffer> buffers_;          // indexed by NB_BIND_*

@@ -73,6 +73,12 @@ NbRayShear g_obj_shear; // nb_ray_shear(g_obj_dir): the per-ray part of the tria
         }                                                                                            \
     }
 
+// g_alpha_seed of a shadow ray from its path's slot in the wave (pixel, sample and depth).
+uint nb_shadow_alpha_seed(uint slot) {
+    uint pixel = nb_slot_pixel(slot, pc.pixel_offset, pc.pixel_count);
+    return nb_pcg_hash(pixel ^ (pc.depth << 24u) ^ nb_slot_sample(slot, pc.sample_index, pc.pixel_count));
+}
+
 // Whether a hit on a triangle counts: alpha masks cut it out; alpha blending is stochastic (the
 // surface is hit with probability alpha), which keeps the estimator unbiased without sorting hits.
 bool nb_alpha_accepts(GpuTriangle tri, vec2 bary) {

@@ -1,5 +1,6 @@
-// Pass 1: one camera ray per pixel of the wave into path-ray queue pc.in_queue (pinhole camera,
-// uniform jitter inside the pixel, row 0 at the top). Also clears the wave's sample radiance.
+// Pass 1: one camera ray per path slot of the wave (pc.wave_samples samples of pc.pixel_count pixels,
+// shared/wavefront_gpu.h) into path-ray queue pc.in_queue (pinhole camera, uniform jitter inside the
+// pixel, row 0 at the top). Also clears the wave's sample radiance.
 #version 460
 #include "lib/bindings.glsl"
 #include "shared/sampling.h"
@@ -8,15 +9,16 @@ layout(local_size_x = NB_WAVEFRONT_GROUP) in;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
+    uint paths = pc.pixel_count * pc.wave_samples;
     if (i == 0u) {
-        if (pc.in_queue == 0u) counters.ray_count0 = pc.pixel_count;
-        else counters.ray_count1 = pc.pixel_count;
+        if (pc.in_queue == 0u) counters.ray_count0 = paths;
+        else counters.ray_count1 = paths;
     }
-    if (i >= pc.pixel_count) return;
-    uint pixel = pc.pixel_offset + i;
+    if (i >= paths) return;
+    uint pixel = nb_slot_pixel(i, pc.pixel_offset, pc.pixel_count);
     uint x = pixel % params.width;
     uint y = pixel / params.width;
-    uint rng = nb_rng_init(pixel, pc.sample_index, params.seed);
+    uint rng = nb_rng_init(pixel, nb_slot_sample(i, pc.sample_index, pc.pixel_count), params.seed);
     float jx = nb_rng_next(rng);
     float jy = nb_rng_next(rng);
     float sx = (2.0f * (float(x) + jx) / float(params.width) - 1.0f) * params.aspect * params.cam_tan_half_fov;
@@ -27,7 +29,7 @@ void main() {
     ray_store3(q, NB_RAY_ORIGIN, i, params.cam_eye);
     ray_store3(q, NB_RAY_DIR, i, dir);
     ray_store3(q, NB_RAY_THROUGHPUT, i, vec3(1.0f));
-    ray_store1(q, NB_RAY_PIXEL, i, pixel);
+    ray_store1(q, NB_RAY_PIXEL, i, i);
     ray_store1(q, NB_RAY_DEPTH, i, 0u);
     ray_store1(q, NB_RAY_RNG, i, rng);
     ray_store1(q, NB_RAY_PDF, i, floatBitsToUint(-1.0f));

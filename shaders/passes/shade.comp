@@ -5,7 +5,7 @@
 //            lib/lights.glsl nb_light_strategies), evaluated here and appended to the shadow queue with its
 //            MIS weight (power heuristic; punctual lights are delta lights: weight 1, NEE only);
 //            BSDF sampling + Russian roulette: the continuation ray is appended to queue 1 - in_queue.
-// Radiance goes to sample_radiance[pixel - pixel_offset] (one path per pixel per wave: no races).
+// Radiance goes to sample_radiance[slot] (the path's slot in the wave, NB_RAY_PIXEL: no races).
 #version 460
 #include "lib/bindings.glsl"
 #include "lib/material.glsl"
@@ -25,11 +25,10 @@ void main() {
     vec3 org = ray_load3(q, NB_RAY_ORIGIN, i);
     vec3 dir = ray_load3(q, NB_RAY_DIR, i);
     vec3 throughput = ray_load3(q, NB_RAY_THROUGHPUT, i);
-    uint pixel = ray_load1(q, NB_RAY_PIXEL, i);
+    uint slot = ray_load1(q, NB_RAY_PIXEL, i);
     uint depth = ray_load1(q, NB_RAY_DEPTH, i);
     uint rng = ray_load1(q, NB_RAY_RNG, i);
     float prev_pdf = uintBitsToFloat(ray_load1(q, NB_RAY_PDF, i));
-    uint local_pixel = pixel - pc.pixel_offset;
     float p_env, p_emissive, p_punctual;
     nb_light_strategies(p_env, p_emissive, p_punctual);
 
@@ -38,7 +37,7 @@ void main() {
         if (NB_HAS_ENVIRONMENT) {
             float w = 1.0f;
             if (prev_pdf > 0.0f) w = nb_power_heuristic(prev_pdf, p_env * nb_env_pdf(dir));
-            sample_radiance[local_pixel] += throughput * nb_env_radiance(dir) * w;
+            sample_radiance[slot] += throughput * nb_env_radiance(dir) * w;
         }
         return;
     }
@@ -55,7 +54,7 @@ void main() {
             float light_pdf = p_emissive * nb_emissive_area_pdf(materials[s.material]) * t * t / max(cos_l, 1.0e-8f);
             w = nb_power_heuristic(prev_pdf, light_pdf);
         }
-        sample_radiance[local_pixel] += throughput * s.emission * w;
+        sample_radiance[slot] += throughput * s.emission * w;
     }
     if (depth + 1u >= params.max_depth) return; // the next segment would exceed --max-depth
 
@@ -91,7 +90,7 @@ void main() {
                 float tmax = dist >= NB_INF ? NB_INF : max(0.0f, length(s.p + wi * dist - o) * (1.0f - 1.0e-4f));
                 shadow_store1(NB_SHADOW_TMAX, k, floatBitsToUint(tmax));
                 shadow_store3(NB_SHADOW_CONTRIB, k, contrib);
-                shadow_store1(NB_SHADOW_PIXEL, k, pixel);
+                shadow_store1(NB_SHADOW_PIXEL, k, slot);
             }
         }
     }
@@ -115,7 +114,7 @@ void main() {
     ray_store3(out_q, NB_RAY_ORIGIN, k, ray_offset(s.p, n_side));
     ray_store3(out_q, NB_RAY_DIR, k, wi);
     ray_store3(out_q, NB_RAY_THROUGHPUT, k, throughput);
-    ray_store1(out_q, NB_RAY_PIXEL, k, pixel);
+    ray_store1(out_q, NB_RAY_PIXEL, k, slot);
     ray_store1(out_q, NB_RAY_DEPTH, k, depth + 1u);
     ray_store1(out_q, NB_RAY_RNG, k, rng);
     ray_store1(out_q, NB_RAY_PDF, k, floatBitsToUint(pdf));

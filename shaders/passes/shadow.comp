@@ -12,8 +12,8 @@ void main() {
     vec3 org = shadow_load3(NB_SHADOW_ORIGIN, i);
     vec3 dir = shadow_load3(NB_SHADOW_DIR, i);
     float tmax = uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, i));
-    uint pixel = shadow_load1(NB_SHADOW_PIXEL, i);
-    g_alpha_seed = nb_pcg_hash(pixel ^ (pc.depth << 24u) ^ pc.sample_index);
+    uint slot = shadow_load1(NB_SHADOW_PIXEL, i);
+    g_alpha_seed = nb_shadow_alpha_seed(slot);
     bool occluded;
     if (NB_HAS_NEURAL && (pc.mode & NB_SHADOW_MODE_HYBRID) != 0u) {
         // Hybrid render: passes/neural_shadow.comp decided (triangles and neural leaves). A renderer
@@ -24,7 +24,7 @@ void main() {
         occluded = g_hit_instance != NB_NO_HIT;
     }
     if (!occluded) {
-        // At most one shadow ray per path per bounce and one path per pixel per wave: no write races.
-        sample_radiance[pixel - pc.pixel_offset] += shadow_load3(NB_SHADOW_CONTRIB, i);
+        // At most one shadow ray per path per bounce and one slot per path: no write races.
+        sample_radiance[slot] += shadow_load3(NB_SHADOW_CONTRIB, i);
     }
 }

@@ -18,7 +18,7 @@
 #define NB_RAY_ORIGIN 0u      // vec3 world space
 #define NB_RAY_DIR 3u         // vec3 world space, unit length
 #define NB_RAY_THROUGHPUT 6u  // vec3 path throughput (already divided by pdfs and RR)
-#define NB_RAY_PIXEL 9u       // uint pixel index within the image
+#define NB_RAY_PIXEL 9u       // uint the path's slot in its wave (nb_slot_pixel / nb_slot_sample)
 #define NB_RAY_DEPTH 10u      // uint segment index of this ray (0 = camera ray)
 #define NB_RAY_RNG 11u        // uint sampler state
 #define NB_RAY_PDF 12u        // float solid-angle pdf of the BSDF sample that made this ray; < 0: delta lobe
@@ -48,7 +48,7 @@ NB_FN uint nb_hit_word(uint field, uint capacity, uint index, uint components) {
 #define NB_SHADOW_DIR 3u          // vec3 unit length
 #define NB_SHADOW_TMAX 6u         // float distance to the light sample (NB_INF: environment)
 #define NB_SHADOW_CONTRIB 7u      // vec3 radiance added to the path when unoccluded (MIS-weighted)
-#define NB_SHADOW_PIXEL 10u       // uint pixel index within the image
+#define NB_SHADOW_PIXEL 10u       // uint the path's slot in its wave, as NB_RAY_PIXEL
 #define NB_SHADOW_WORDS 11u
 
 NB_FN uint nb_shadow_word(uint field, uint capacity, uint index, uint components) {
@@ -111,7 +111,14 @@ struct GpuPassConstants {
     uint pixel_offset;  // first pixel of the current wave
     uint pixel_count;   // pixels in the current wave
     uint mode;          // pass-specific (NB_ARGS_MODE_*, NB_SHADOW_MODE_*)
+    uint wave_samples;  // samples per pixel in the current wave (sample_index .. + wave_samples - 1)
 };
-NB_STATIC_ASSERT(sizeof(GpuPassConstants) == 24, "GpuPassConstants layout");
+NB_STATIC_ASSERT(sizeof(GpuPassConstants) == 28, "GpuPassConstants layout");
+
+// A wave traces wave_samples samples of pixel_count consecutive pixels: pixel_count * wave_samples
+// paths, one per slot, slot = (sample - sample_index) * pixel_count + (pixel - pixel_offset). Small
+// images take several samples per wave so the GPU stays full (engine/render/wavefront.cpp).
+NB_FN uint nb_slot_pixel(uint slot, uint pixel_offset, uint pixel_count) { return pixel_offset + slot % pixel_count; }
+NB_FN uint nb_slot_sample(uint slot, uint sample_index, uint pixel_count) { return sample_index + slot / pixel_count; }
 
 #endif

@@ -82,7 +82,7 @@
     F(ray_count0) F(ray_count1) F(shadow_count) F(pending_count) F(rays_primary)                  \
     F(rays_secondary) F(rays_shadow) F(nonfinite_samples)
 #define NB_LAYOUT_FIELDS_GpuPassConstants(F)                                                      \
-    F(in_queue) F(depth) F(sample_index) F(pixel_offset) F(pixel_count) F(mode)
+    F(in_queue) F(depth) F(sample_index) F(pixel_offset) F(pixel_count) F(mode) F(wave_samples)
 #define NB_LAYOUT_FIELDS_GpuNeuralQuery(F) F(origin) F(t_entry) F(dir) F(t_exit)
 #define NB_LAYOUT_FIELDS_GpuNeuralHit(F) \
     F(normal) F(t) F(albedo) F(visibility) F(depth) F(flags) F(pad0) F(pad1)
