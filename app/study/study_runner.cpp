@@ -318,17 +318,32 @@ void StudyRun::run_config(size_t index, const Config& c) {
         dec_accel = build_scene_accel(dec->scene);
     }
 
-    for (size_t ci = 0; ci < cams_.size(); ++ci) {
-        CameraSide& cam = cams_[ci];
-        RenderOptions ho = image_options(o_.render.spp, o_.render.seed);
-        ho.neural.model = &model;
-        WavefrontRenderer hybrid(*ctx_, hybrid_scene, accel_, env_, cam.camera, ho);
-        std::unique_ptr<WavefrontRenderer> timing;
+    // One renderer per image size for every camera (set_camera), for the model and for the decimated
+    // scene: building one (scene upload, pipelines) costs about as much as a variant's renders.
+    RenderOptions ho = image_options(o_.render.spp, o_.render.seed);
+    ho.neural.model = &model;
+    WavefrontRenderer hybrid(*ctx_, hybrid_scene, accel_, env_, cams_.front().camera, ho);
+    std::unique_ptr<WavefrontRenderer> timing;
+    if (separate_timing()) {
+        RenderOptions t = timing_options();
+        t.neural.model = &model;
+        timing = std::make_unique<WavefrontRenderer>(*ctx_, hybrid_scene, accel_, env_, cams_.front().camera, t);
+    }
+    RenderOptions dopt = image_options(o_.render.spp, o_.render.seed);
+    dopt.neural.classical = true;
+    std::unique_ptr<WavefrontRenderer> dr, dtiming;
+    if (dec) {
+        dr = std::make_unique<WavefrontRenderer>(*ctx_, dec->scene, *dec_accel, env_, cams_.front().camera, dopt);
         if (separate_timing()) {
             RenderOptions t = timing_options();
-            t.neural.model = &model;
-            timing = std::make_unique<WavefrontRenderer>(*ctx_, hybrid_scene, accel_, env_, cam.camera, t);
+            t.neural.classical = true;
+            dtiming = std::make_unique<WavefrontRenderer>(*ctx_, dec->scene, *dec_accel, env_, cams_.front().camera, t);
         }
+    }
+    for (size_t ci = 0; ci < cams_.size(); ++ci) {
+        CameraSide& cam = cams_[ci];
+        for (WavefrontRenderer* r : {&hybrid, timing.get(), dr.get(), dtiming.get()})
+            if (r) r->set_camera(cam.camera);
         Image base_px;
         for (const Variant& v : variants) {
             RenderOptions vo = ho;
@@ -386,16 +401,6 @@ void StudyRun::run_config(size_t index, const Config& c) {
             progress_.begin(StudyTask::render, pixel_samples(o_.render.spp) + timing_work(),
                             strfmt("%s, camera %zu: decimated to %llu triangles", label.c_str(), ci,
                                    (unsigned long long)dec->triangles));
-            RenderOptions dopt = image_options(o_.render.spp, o_.render.seed);
-            dopt.neural.classical = true;
-            WavefrontRenderer dr(*ctx_, dec->scene, *dec_accel, env_, cam.camera, dopt);
-            std::unique_ptr<WavefrontRenderer> dtiming;
-            if (separate_timing()) {
-                RenderOptions t = timing_options();
-                t.neural.classical = true;
-                dtiming =
-                    std::make_unique<WavefrontRenderer>(*ctx_, dec->scene, *dec_accel, env_, cam.camera, t);
-            }
             StudyRow row;
             row.config = int(index);
             row.variant = "decimated";
@@ -407,10 +412,10 @@ void StudyRun::run_config(size_t index, const Config& c) {
             row.triangles = dec->triangles;
             row.compression = double(source_bytes_) / double(dec->bytes);
             row.decimation_sloppy = dec->sloppy;
-            row.frame_ms = time_frame(dr, dtiming.get(), dopt);
+            row.frame_ms = time_frame(*dr, dtiming.get(), dopt);
             row.classical_frame_ms = cam.classical_ms;
             row.ratio_to_classical = row.frame_ms / cam.classical_ms;
-            const render::RenderResult res = render_with(dr, dopt);
+            const render::RenderResult res = render_with(*dr, dopt);
             const Image px = as_png_pixels(res.image, cam.exposure);
             row.flip = flip_ldr(cam.ref_px, px).mean;
             row.noise_floor = cam.noise_floor;
