@@ -1,6 +1,6 @@
 // Two-level acceleration structure of a Scene: one MeshBvh (BLAS) per mesh and a TLAS built with
 // build_bvh over instance world bounds. CPU closest/any hit in world space. The renderer packs its
-// GPU buffers from this: per mesh to_gpu_layout(meshes[m].bvh) + meshes[m].vertices /
+// GPU buffers from this: per mesh to_wide_layout(meshes[m].bvh) (wide_bvh.h) + meshes[m].vertices /
 // bvh.prim_indices, and to_gpu_layout(tlas) whose leaf refs index tlas.prim_indices (instance ids).
 #pragma once
 #include <cstdint>

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "engine/bvh/wide_bvh.h"
 #include "engine/render/neural_model_gpu.h"
 #include "shaders/shared/neural_gpu.h"
 #include "shaders/shared/scene_gpu.h"
@@ -12,7 +13,7 @@ namespace nbvh::render {
 uint64_t mesh_gpu_bytes(const Mesh& mesh, const MeshBvh& blas) {
     return uint64_t(mesh.positions.size()) * sizeof(GpuVertex) +
            uint64_t(blas.triangle_count()) * sizeof(GpuTriangle) +
-           uint64_t(to_gpu_layout(blas.bvh).size()) * sizeof(GpuBvhNode);
+           uint64_t(to_wide_layout(blas.bvh).size()) * sizeof(GpuWideNode);
 }
 
 uint64_t mesh_gpu_bytes(const Mesh& mesh) { return mesh_gpu_bytes(mesh, build_mesh_bvh(mesh)); }

@@ -12,7 +12,7 @@
 namespace nbvh::render {
 
 // A mesh as pack_scene uploads it: every vertex (GpuVertex), the triangles its BLAS keeps (GpuTriangle) and
-// the BLAS nodes (GpuBvhNode, to_gpu_layout). Textures and materials are not counted (both
+// the BLAS nodes (GpuWideNode, to_wide_layout). Textures and materials are not counted (both
 // representations shade with them).
 uint64_t mesh_gpu_bytes(const Mesh& mesh, const MeshBvh& blas);
 uint64_t mesh_gpu_bytes(const Mesh& mesh); // builds the BLAS with default_blas_options()

@@ -189,18 +189,18 @@ GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Envir
                                                 base + mesh.indices[3 * original + 2], mat});
             out.triangle_to_mesh_triangle.push_back(original);
         }
+        // 4-wide quantized BLAS (to_wide_layout: an empty mesh gets a node without children).
         mesh_blas_root[m] = uint32_t(out.blas_nodes.size());
-        std::vector<GpuBvhNode> nodes = to_gpu_layout(blas.bvh);
         const uint32_t offset = mesh_blas_root[m];
-        for (GpuBvhNode& n : nodes) {
-            if (!nb_is_leaf(n.left) && n.left != NB_CHILD_NONE) n.left += offset;
-            if (!nb_is_leaf(n.right) && n.right != NB_CHILD_NONE) n.right += offset;
+        for (GpuWideNode n : to_wide_layout(blas.bvh)) {
+            for (uint32_t* ref : {&n.child0, &n.child1, &n.child2, &n.child3})
+                if (!nb_is_leaf(*ref) && *ref != NB_CHILD_NONE) *ref += offset;
             out.blas_nodes.push_back(n);
         }
     }
     if (out.vertices.empty()) out.vertices.push_back(GpuVertex{});
     if (out.triangles.empty()) out.triangles.push_back(GpuTriangle{0, 0, 0, 0});
-    if (out.blas_nodes.empty()) out.blas_nodes.push_back(GpuBvhNode{});
+    if (out.blas_nodes.empty()) out.blas_nodes.push_back(to_wide_layout(Bvh{})[0]);
 
     // Instances in TLAS leaf order; inverted-hull outlines are seen by camera rays only (outline_shells.h).
     const std::vector<bool> shells = find_outline_shells(scene);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "engine/bvh/scene_accel.h"
+#include "engine/bvh/wide_bvh.h"
 #include "engine/render/environment_sampler.h"
 #include "engine/scene/scene.h"
 #include "shaders/shared/bvh_node.h"
@@ -15,7 +16,7 @@ namespace nbvh::render {
 
 struct GpuSceneData {
     std::vector<GpuBvhNode> tlas_nodes;   // leaf refs index `instances`
-    std::vector<GpuBvhNode> blas_nodes;   // all BLASes; interior refs already offset to this array
+    std::vector<GpuWideNode> blas_nodes;  // all BLASes (4-wide, to_wide_layout); interior refs offset to this array
     std::vector<GpuInstance> instances;   // TLAS leaf order
     std::vector<GpuTriangle> triangles;   // per mesh in BLAS leaf order, concatenated
     std::vector<GpuVertex> vertices;      // all meshes' vertices, concatenated

@@ -10,6 +10,7 @@
 
 #include "shared/compat.h"
 #include "shared/bvh_node.h"
+#include "shared/wide_bvh_node.h"
 #include "shared/scene_gpu.h"
 #include "shared/wavefront_gpu.h"
 
@@ -30,7 +31,7 @@ layout(push_constant, scalar) uniform PassConstantsBlock { GpuPassConstants pc; 
 layout(set = 0, binding = NB_BIND_PARAMS, scalar) readonly buffer ParamsBuffer { GpuFrameParams params; };
 layout(set = 0, binding = NB_BIND_COUNTERS, scalar) coherent buffer CountersBuffer { GpuQueueCounters counters; };
 layout(set = 0, binding = NB_BIND_TLAS_NODES, std430) readonly buffer TlasBuffer { GpuBvhNode tlas_nodes[]; };
-layout(set = 0, binding = NB_BIND_BLAS_NODES, std430) readonly buffer BlasBuffer { GpuBvhNode blas_nodes[]; };
+layout(set = 0, binding = NB_BIND_BLAS_NODES, std430) readonly buffer BlasBuffer { GpuWideNode blas_nodes[]; };
 layout(set = 0, binding = NB_BIND_INSTANCES, std430) readonly buffer InstanceBuffer { GpuInstance instances[]; };
 layout(set = 0, binding = NB_BIND_TRIANGLES, std430) readonly buffer TriangleBuffer { GpuTriangle triangles[]; };
 layout(set = 0, binding = NB_BIND_VERTICES, scalar) readonly buffer VertexBuffer { GpuVertex vertices[]; };

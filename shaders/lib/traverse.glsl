@@ -1,7 +1,8 @@
 // Two-level BVH traversal (TLAS over instances, one BLAS per mesh) for the wavefront passes.
 //
-// The traversal loop (NB_TRAVERSE_BVH) is written once and knows nothing of what a leaf contains: it
-// hands (first, count) of each leaf it reaches to a leaf handler (madmann91/bvh). Two handlers exist:
+// The binary loop (NB_TRAVERSE_BVH: TLAS, N-BVH) and the 4-wide one (NB_TRAVERSE_WIDE, shared/wide_bvh_node.h:
+// the triangle BLAS) are each written once and know nothing of what a leaf contains: they
+// hand (first, count) of each leaf they reach to a leaf handler (madmann91/bvh). Two handlers exist:
 //   - nb_instance_leaf: a TLAS leaf, i.e. instances; it dispatches on the instance kind. Triangle
 //     instances transform the ray and traverse their BLAS with nb_triangle_leaf. The neural issue adds
 //     the NB_INSTANCE_NEURAL case (traverse the N-BVH, append (ray, leaf) pairs to the pending-leaf
@@ -33,7 +34,7 @@ vec3 g_obj_org;        // the ray in that instance's object space
 vec3 g_obj_dir;
 NbRayShear g_obj_shear; // nb_ray_shear(g_obj_dir): the per-ray part of the triangle test
 
-// Iterative nearest-first traversal of one two-child BVH. NODES: node array; ROOT: root node index
+// Iterative nearest-first traversal of one two-child BVH (the TLAS; the N-BVH in lib/neural_traverse.glsl). NODES: node array; ROOT: root node index
 // (an interior node or a leaf reference); ORG, INV_DIR: the ray in the tree's space; LEAF(first, count):
 // the leaf handler. Culls by g_tmin/g_tmax (the handler narrows g_tmax) and stops when g_done is set.
 // The loop descends into the nearer child directly and pushes only the farther one, as a reference: a
@@ -123,7 +124,9 @@ void nb_traverse_triangle_instance(uint instance) {
     g_obj_dir = nb_xform_vector(inst.world_to_object, g_dir);
     if (!nb_ray_shear(g_obj_dir, g_obj_shear)) return; // a zero direction hits no triangle
     vec3 inv_dir = nb_safe_inv_dir(g_obj_dir);
-    NB_TRAVERSE_BVH(blas_nodes, inst.blas_root, g_obj_org, inv_dir, nb_triangle_leaf)
+    // The BLAS is 4-wide with quantized child boxes (shared/wide_bvh_node.h): one loop for the GPU and
+    // the CPU mirror the tests run (engine/bvh/wide_bvh.h).
+    NB_TRAVERSE_WIDE(blas_nodes, inst.blas_root, g_obj_org, inv_dir, g_tmin, g_tmax, g_done, nb_triangle_leaf)
 }
 
 // The neural leaf kind (N-BVH walk, pending pairs / inline shadow queries): lib/neural_traverse.glsl.

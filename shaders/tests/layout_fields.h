@@ -15,6 +15,7 @@
 #define NB_LAYOUT_FIELDS_H
 #include "../shared/compat.h"
 #include "../shared/bvh_node.h"
+#include "../shared/wide_bvh_node.h"
 #include "../shared/hashgrid.h"
 #include "../shared/neural_query.h"
 #include "../shared/scene_gpu.h"
@@ -44,11 +45,14 @@
     S(GpuNeuralRayState, 18) \
     S(GpuNeuralParams, 19)   \
     S(GpuNeuralCounters, 20) \
-    S(GpuNeuralAsset, 21)
+    S(GpuNeuralAsset, 21)    \
+    S(GpuWideNode, 22)
 
 // --- field lists ---------------------------------------------------------------------------------
 #define NB_LAYOUT_FIELDS_GpuBvhNode(F) \
     F(lmin) F(left) F(lmax) F(right) F(rmin) F(pad0) F(rmax) F(pad1)
+#define NB_LAYOUT_FIELDS_GpuWideNode(F) \
+    F(origin) F(child0) F(scale) F(child1) F(qlo_x) F(qlo_y) F(qlo_z) F(child2) F(qhi_x) F(qhi_y) F(qhi_z) F(child3)
 #define NB_LAYOUT_FIELDS_GpuHashLevel(F) \
     F(offset) F(size) F(resolution) F(scale) F(hashed) F(pad0) F(pad1) F(pad2)
 #define NB_LAYOUT_FIELDS_GpuEncodingBox(F) \

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "engine/bvh/wide_bvh.h"
 #include "engine/neural/level_table.h"
 #include "engine/render/decimation.h"
 #include "engine/render/gpu_memory.h"
@@ -111,7 +112,7 @@ TEST(GpuMemory, MeshBytesCountVerticesTrianglesAndBlas) {
     const Mesh m = sphere(4, 8);
     const MeshBvh blas = build_mesh_bvh(m);
     EXPECT_EQ(render::mesh_gpu_bytes(m),
-              m.positions.size() * 56 + m.triangle_count() * 16 + to_gpu_layout(blas.bvh).size() * 64);
+              m.positions.size() * 56 + m.triangle_count() * 16 + to_wide_layout(blas.bvh).size() * 64);
 }
 
 TEST(GpuMemory, NeuralBytesPerLod) {

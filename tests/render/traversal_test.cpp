@@ -5,6 +5,8 @@
 #include <cmath>
 #include <random>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "engine/bvh/scene_accel.h"
 #include "engine/render/wavefront.h"
 #include "engine/scene/gltf_loader.h"
@@ -40,9 +42,10 @@ void make_rays(const Aabb& b, size_t n, uint32_t seed, std::vector<glm::vec3>& o
     }
 }
 
-void compare_with_cpu(const Scene& scene, size_t ray_count, double min_agreement, double min_hits = 0.5) {
+void compare_with_cpu(const Scene& scene, size_t ray_count, double min_agreement, double min_hits = 0.5,
+                      const BvhBuildOptions& blas = default_blas_options()) {
     vk::Context ctx = make_lavapipe();
-    const SceneAccel accel = build_scene_accel(scene);
+    const SceneAccel accel = build_scene_accel(scene, blas);
     RenderOptions opt;
     opt.width = 64;
     opt.height = 32;
@@ -82,6 +85,40 @@ TEST(GpuTraversal, MatchesCpuOnSingleSidedQuad) {
     Scene s = test::make_quad_scene();
     s.materials[0].double_sided = false;
     compare_with_cpu(s, 512, 0.999, 0.3);
+}
+
+// Wide-BLAS corners the default build never makes (shared/wide_bvh_node.h): leaves of 16 triangles (the
+// most a leaf reference holds) under 4-wide nodes, in two meshes (node references offset by the first
+// BLAS) and a rotated instance; the quad's BLAS is one node with one leaf child.
+TEST(GpuTraversal, MatchesCpuWithLeavesOfSixteen) {
+    Scene s = test::make_quad_scene();
+    std::mt19937 rng(77);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    Mesh soup;
+    for (uint32_t i = 0; i < 3000; ++i) {
+        const glm::vec3 c(u(rng), u(rng), u(rng));
+        for (int k = 0; k < 3; ++k) {
+            soup.indices.push_back(uint32_t(soup.positions.size()));
+            soup.positions.push_back(c + 0.15f * glm::vec3(u(rng), u(rng), u(rng)));
+        }
+        soup.triangle_material.push_back(0);
+    }
+    s.meshes.push_back(soup);
+    Instance inst;
+    inst.mesh = 1;
+    s.instances.push_back(inst);
+    inst.object_to_world = glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(0.5f, 0.0f, 0.3f)), 0.7f,
+                                       glm::vec3(0.3f, 1.0f, 0.2f));
+    s.instances.push_back(inst);
+    s.materials[0].double_sided = true;
+    BvhBuildOptions o = default_blas_options();
+    o.max_leaf_size = NB_LEAF_MAX_COUNT;
+    o.traversal_cost = 1000.0f; // splitting costs more than 16 triangle tests: full leaves
+    const SceneAccel accel = build_scene_accel(s, o);
+    uint32_t largest = 0;
+    for (const BvhNode& n : accel.meshes[1].bvh.nodes) largest = std::max(largest, n.count);
+    ASSERT_EQ(largest, NB_LEAF_MAX_COUNT);
+    compare_with_cpu(s, 1024, 0.995, 0.5, o);
 }
 
 TEST(GpuTraversal, MatchesCpuOnStanfordBunny) {
