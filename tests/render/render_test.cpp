@@ -2,6 +2,7 @@
 // messages, zero non-finite pixels and samples, a non-black, non-uniform image, and determinism.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "assets/default_scene.h"
@@ -25,7 +26,7 @@ struct Rendered {
 };
 
 Rendered render_small(const Scene& scene, const Environment& env, uint32_t spp = 4, uint32_t max_depth = 3,
-                      uint32_t seed = 1, uint32_t width = 48, uint32_t height = 32) {
+                      uint32_t seed = 1, uint32_t width = 48, uint32_t height = 32, uint32_t wave_pixels = 1024) {
     vk::ContextOptions o;
     o.device = vk::DeviceChoice::cpu;
     o.validation = true;
@@ -37,7 +38,7 @@ Rendered render_small(const Scene& scene, const Environment& env, uint32_t spp =
     opt.spp = spp;
     opt.max_depth = max_depth;
     opt.seed = seed;
-    opt.max_wave_pixels = 1024; // two waves: exercises the wave offsets
+    opt.max_wave_pixels = wave_pixels; // 1024 at 48x32: two waves, exercises the wave offsets
     const Camera cam = scene.has_camera ? scene.camera : auto_frame(scene, 1.5f);
     WavefrontRenderer r(ctx, scene, accel, env, cam, opt);
     Rendered out;
@@ -124,6 +125,28 @@ TEST(Render, SameSeedSameImage) {
     const Rendered a = render_small(s, constant_environment(glm::vec3(1.0f)), 2, 3, 7);
     const Rendered b = render_small(s, constant_environment(glm::vec3(1.0f)), 2, 3, 7);
     EXPECT_EQ(a.result.image.data, b.result.image.data);
+}
+
+// A small image traces several samples per wave (a path per slot: nb_slot_pixel / nb_slot_sample) and
+// accumulates each pixel's slots; the image must equal the one-sample-per-wave render of the same
+// random numbers (float summation order aside). 21 spp at 16 samples per wave: a full and a partial wave.
+TEST(Render, SamplesPerWaveKeepTheImage) {
+    Scene s = test::make_quad_scene();
+    const Environment env = constant_environment(glm::vec3(1.0f));
+    const uint32_t w = 24, h = 16, spp = 21;
+    const Rendered one = render_small(s, env, spp, 3, 5, w, h, w * h);  // waves of exactly the image
+    const Rendered many = render_small(s, env, spp, 3, 5, w, h, 1u << 22); // up to 16 samples per wave
+    expect_sane(one);
+    expect_sane(many);
+    EXPECT_EQ(one.result.stats.rays_primary, many.result.stats.rays_primary);
+    EXPECT_EQ(one.result.stats.rays_secondary, many.result.stats.rays_secondary);
+    EXPECT_EQ(one.result.stats.rays_shadow, many.result.stats.rays_shadow);
+    ASSERT_EQ(one.result.image.data.size(), many.result.image.data.size());
+    double worst = 0.0;
+    for (size_t i = 0; i < one.result.image.data.size(); ++i)
+        worst = std::max(worst, double(std::abs(one.result.image.data[i] - many.result.image.data[i])) /
+                                    std::max(1e-3, double(std::abs(one.result.image.data[i]))));
+    EXPECT_LT(worst, 1e-5) << "several samples per wave changed the image";
 }
 
 TEST(Render, ValidQuadGlb) {
