@@ -37,8 +37,8 @@ struct TrainArgs {
     std::string backend = "auto";
     std::string log_csv;
     // Unset (not given on the command line) = the backend's default.
-    std::optional<uint32_t> nodes, hash_log2, steps, batch;
-    uint32_t lods = 1, threads = 0;
+    std::optional<uint32_t> nodes, hash_log2, steps, batch, lods;
+    uint32_t threads = 0;
     uint64_t seed = 1337;
     bool deterministic = false; // CUDA backend: order-independent gradient sums (trainer/cuda/README.md)
 };
@@ -50,7 +50,7 @@ void run_train(const TrainArgs& a) {
     if (a.hash_log2) opt.network.log2_hash_size = *a.hash_log2;
     if (a.steps) opt.steps = *a.steps;
     if (a.batch) opt.batch_size = *a.batch;
-    opt.lods = a.lods;
+    if (a.lods) opt.lods = *a.lods;
     opt.seed = a.seed;
     opt.threads = a.threads;
     opt.deterministic = a.deterministic;
@@ -120,7 +120,7 @@ void add_train_command(CLI::App& app) {
     cmd->add_option("--hash-log2", args->hash_log2, "log2 of the hash-table entries per level (default: compact, the largest up to CPU 15 / CUDA 18 whose grid is at most 1/5 of the replaced mesh + BLAS)");
     cmd->add_option("--steps", args->steps, "optimiser steps (CPU default 1000, CUDA 10000)");
     cmd->add_option("--batch", args->batch, "rays per step (CPU default 2048, CUDA 262144)");
-    cmd->add_option("--lods", args->lods, "cuts kept as levels of detail (1..8)");
+    cmd->add_option("--lods", args->lods, "cuts kept as levels of detail (1..8, default 3: render and view trace rays after the first hit on the coarsest)");
     cmd->add_option("--seed", args->seed, "random seed (network init and rays)");
     cmd->add_option("--threads", args->threads, "CPU backend threads (default: all cores)");
     cmd->add_flag("--deterministic", args->deterministic, "CUDA backend: bit-reproducible steps (slower)");

@@ -7,7 +7,9 @@
 # NEW images (0 when the change is exact). Writes OUT/ab.json and prints a table.
 # Usage (GPU machine, after `source .device/env.sh`): scripts/bench/ab_frames.sh OLD NEW OUT
 # Env: DRAGON (xz-packed glb, default .device/study/dragon/dragon_vrip.glb.xz), SPP (default 16), WIDTH, HEIGHT,
-#      TRAIN_ARGS (extra `nbvh train` flags for both models), RENDER_ARGS (extra render flags, both binaries).
+#      TRAIN_ARGS (extra `nbvh train` flags for both models), RENDER_ARGS (extra render flags, both binaries),
+#      OLD_TRAIN_ARGS (when set, OLD renders its own models, trained by OLD with these flags: an A/B of
+#      training settings; OLD may then be the same binary as NEW).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 OLD=$1 NEW=$2 OUT=$3
@@ -23,21 +25,30 @@ R=(--width "${WIDTH:-1920}" --height "${HEIGHT:-1080}" --max-depth 8 --exposure 
 TA=(${TRAIN_ARGS:-})
 "$NEW" train default "${TA[@]}" --out "$T/default.nbvh" > "$T/train_default.log" 2>&1
 "$NEW" train "$T/dragon.glb" --neural '*' "${TA[@]}" --out "$T/dragon.nbvh" > "$T/train_dragon.log" 2>&1
-row() { # NAME ARGS...
+OLDM=$T # where OLD's models are
+if [ -n "${OLD_TRAIN_ARGS+x}" ]; then
+  OLDM=$T/old && mkdir -p "$OLDM"
+  # shellcheck disable=SC2206
+  OTA=(${OLD_TRAIN_ARGS})
+  "$OLD" train default "${OTA[@]}" --out "$OLDM/default.nbvh" > "$T/train_default_old.log" 2>&1
+  "$OLD" train "$T/dragon.glb" --neural '*' "${OTA[@]}" --out "$OLDM/dragon.nbvh" > "$T/train_dragon_old.log" 2>&1
+fi
+cp "$T"/train_*.log "$OUT"/
+row() { # NAME ARGS... (@M@ in ARGS: the binary's model folder)
   local name=$1; shift
-  "$NEW" render "$@" "${R[@]}" --spp 4 --out "$T/warm.png" > /dev/null 2>&1
+  "$NEW" render "${@//@M@/$T}" "${R[@]}" --spp 4 --out "$T/warm.png" > /dev/null 2>&1
   for rep in 1 2; do
     for b in old new; do
-      local bin=$OLD; [ $b = new ] && bin=$NEW
-      "$bin" render "$@" "${R[@]}" --spp "$SPP" --out "$T/${name}_$b.png" --stats "$T/${name}_${b}_$rep.json" > /dev/null 2>&1
+      local bin=$OLD m=$OLDM; [ $b = new ] && bin=$NEW m=$T
+      "$bin" render "${@//@M@/$m}" "${R[@]}" --spp "$SPP" --out "$T/${name}_$b.png" --stats "$T/${name}_${b}_$rep.json" > /dev/null 2>&1
     done
   done
   "$NEW" flip "$T/${name}_old.png" "$T/${name}_new.png" 2>&1 | tail -1 > "$T/${name}_flip.txt"
 }
 row default_classical default --classical
-row default_hybrid default --model "$T/default.nbvh"
+row default_hybrid default --model @M@/default.nbvh
 row dragon_classical "$T/dragon.glb" --neural '*' --classical
-row dragon_hybrid "$T/dragon.glb" --model "$T/dragon.nbvh"
+row dragon_hybrid "$T/dragon.glb" --model @M@/dragon.nbvh
 python3 - "$T" "$OUT/ab.json" "$OLD" "$NEW" <<'PY'
 import glob, json, os, re, sys
 t, out = sys.argv[1], sys.argv[2]
@@ -55,7 +66,8 @@ for name in ["default_classical", "default_hybrid", "dragon_classical", "dragon_
     r["flip_ldr_old_vs_new"] = float(m.group()) if m else None
     r["new_over_old"] = r["new"]["ms_per_spp"] / r["old"]["ms_per_spp"]
     rows[name] = r
-json.dump({"old": sys.argv[3], "new": sys.argv[4], "rows": rows}, open(out, "w"), indent=1)
+json.dump({"old": sys.argv[3], "new": sys.argv[4], "old_train_args": os.environ.get("OLD_TRAIN_ARGS"),
+           "train_args": os.environ.get("TRAIN_ARGS", ""), "rows": rows}, open(out, "w"), indent=1)
 for k, r in rows.items():
     print("%-18s old %6.2f  new %6.2f ms/spp  new/old %.3f  FLIP old vs new %s" % (
         k, r["old"]["ms_per_spp"], r["new"]["ms_per_spp"], r["new_over_old"], r["flip_ldr_old_vs_new"]))

@@ -58,17 +58,26 @@ int main(int argc, char** argv) try {
     }
     TrainingCut cut;
     cut.assign(leaves, asset.bvh().nodes.size());
-    auto backend = make_cuda_backend_ex(asset, opt.network, make_adam_config(opt), CudaBackendOptions{}, opt.seed);
     StepParams p;
     p.batch_size = opt.batch_size;
     p.seed = opt.seed;
     p.cuts = {&cut};
     p.cut_version = 1;
-    for (uint32_t s = 0; s < 20; ++s) { p.step = s; backend->step(p); }
-    const uint32_t timed = 100;
-    const double t0 = now_s();
-    for (uint32_t s = 0; s < timed; ++s) { p.step = 20 + s; backend->step(p); }
-    const double step_s = (now_s() - t0) / timed;
+    // Mean wall time of 100 steps after 20 warm-up, with the next batch drawn during the network part
+    // (the default) and without (every phase in sequence).
+    auto time_steps = [&](CudaTrainerBackend& b) {
+        for (uint32_t s = 0; s < 20; ++s) { p.step = s; b.step(p); }
+        const uint32_t timed = 100;
+        const double t0 = now_s();
+        for (uint32_t s = 0; s < timed; ++s) { p.step = 20 + s; b.step(p); }
+        return (now_s() - t0) / timed;
+    };
+    CudaBackendOptions serial_opt;
+    serial_opt.prefetch = false;
+    const double serial_s =
+        time_steps(*make_cuda_backend_ex(asset, opt.network, make_adam_config(opt), serial_opt, opt.seed));
+    auto backend = make_cuda_backend_ex(asset, opt.network, make_adam_config(opt), CudaBackendOptions{}, opt.seed);
+    const double step_s = time_steps(*backend);
     backend->set_timing(true);
     CudaPhaseTimes acc{};
     const uint32_t phases_n = 20;
@@ -83,7 +92,8 @@ int main(int argc, char** argv) try {
     const double net_ms = acc.encode + acc.mlp + acc.grid_backward + acc.reduce_adam;
     const double full_sps = opt.batch_size / step_s, net_sps = opt.batch_size / (net_ms * 1e-3),
                  mlp_sps = opt.batch_size / (acc.mlp * 1e-3);
-    std::printf("full step: %.3f ms, %.4f G samples/s (cut of %zu leaves)\n", step_s * 1e3, full_sps * 1e-9, leaves.size());
+    std::printf("full step: %.3f ms, %.4f G samples/s (cut of %zu leaves); without prefetch %.3f ms, %.4f G samples/s\n",
+                step_s * 1e3, full_sps * 1e-9, leaves.size(), serial_s * 1e3, opt.batch_size / serial_s * 1e-9);
     std::printf("phases (ms): sample %.3f, truth %.3f, encode %.3f, mlp %.3f, grid backward %.3f, reduce+guard+adam %.3f\n",
                 acc.sample, acc.truth, acc.encode, acc.mlp, acc.grid_backward, acc.reduce_adam);
     std::printf("network part (encode+mlp+grid bwd+adam): %.4f G samples/s; fused MLP alone %.4f G samples/s\n",
@@ -111,7 +121,7 @@ int main(int argc, char** argv) try {
         f << "{\n  \"device\": \"" << device << "\",\n  \"asset\": \"" << asset.name << "\",\n  \"triangles\": "
           << asset.triangle_count() << ",\n  \"batch\": " << opt.batch_size << ",\n  \"log2_hash\": "
           << opt.network.log2_hash_size << ",\n  \"step_ms\": " << step_s * 1e3 << ",\n  \"full_step_samples_per_s\": "
-          << full_sps << ",\n  \"phase_ms\": {\"sample\": " << acc.sample << ", \"truth\": " << acc.truth
+          << full_sps << ",\n  \"step_ms_without_prefetch\": " << serial_s * 1e3 << ",\n  \"phase_ms\": {\"sample\": " << acc.sample << ", \"truth\": " << acc.truth
           << ", \"encode\": " << acc.encode << ", \"mlp\": " << acc.mlp << ", \"grid_backward\": " << acc.grid_backward
           << ", \"reduce_adam\": " << acc.reduce_adam << "},\n  \"network_samples_per_s\": " << net_sps
           << ",\n  \"mlp_samples_per_s\": " << mlp_sps << ",\n  \"train_steps\": " << steps

@@ -10,6 +10,7 @@
 
 #include "engine/neural/losses.h"
 #include "engine/scene/gltf_loader.h"
+#include "tests/cuda/cuda_test_cuts.h"
 #include "tests/support/test_support.h"
 #include "tests/trainer/trainer_test_scenes.h"
 #include "trainer/cpu/cpu_backend.h"
@@ -25,25 +26,7 @@ namespace {
         if (!cuda_backend_available()) GTEST_SKIP() << "no usable CUDA GPU";                    \
     } while (0)
 
-// A cut of the base BVH: every node at `depth` (or a leaf above it).
-TrainingCut cut_at_depth(const TrainingAsset& a, uint32_t depth) {
-    std::vector<uint32_t> leaves;
-    std::vector<uint32_t> stack{0};
-    while (!stack.empty()) {
-        const uint32_t n = stack.back();
-        stack.pop_back();
-        const BvhNode& node = a.bvh().nodes[n];
-        if (node.is_leaf() || node.depth >= depth) {
-            leaves.push_back(n);
-            continue;
-        }
-        stack.push_back(node.left);
-        stack.push_back(node.right);
-    }
-    TrainingCut c;
-    c.assign(leaves, a.bvh().nodes.size());
-    return c;
-}
+using test::cut_at_depth;
 
 Scene load_bunny() {
     SceneLoadOptions lo;

@@ -345,6 +345,7 @@ TEST(Trainer, HitProbabilityIsUnbiasedByRedraws) {
     TrainOptions o = default_train_options(BackendChoice::cpu);
     o.steps = 400;
     o.target_nodes = 5;
+    o.lods = 1; // the scripted backend reports one cut
     ScriptedBackend backend;
     const TrainResult r = train_asset(asset, o, backend);
     EXPECT_EQ(r.tree.node_count(), 5u);

@@ -129,6 +129,7 @@ public:
         // Paper weights, linearised normals, masking (as the CPU backend).
         c.loss = neural::to_gpu(neural::LossConfig{});
         c.deterministic = options.deterministic;
+        c.prefetch = options.prefetch;
         c.loss_scale = options.loss_scale;
         if (!(c.loss_scale >= 1.0f && c.loss_scale <= 65536.0f)) throw Error("CUDA loss scale must be in [1, 65536]");
         try {

@@ -20,6 +20,10 @@ struct CudaBackendOptions {
     // runs for a seed on one GPU model (nbvh train --deterministic, TrainOptions::deterministic).
     bool deterministic = false;
     float loss_scale = 128.0f; // per-sample loss scale of the fp16 backward (halved on overflow)
+    // Draw step k+1's rays and ground truth while step k's network part runs (a second stream). Step
+    // k+1 then samples with step k's keep probabilities (one step older than without prefetch); a cut
+    // change drops the batch drawn ahead. Same rays otherwise (cuda_backend_test.cpp).
+    bool prefetch = true;
 };
 
 // One drawn sample as the CUDA step saw it (tests).

@@ -1,6 +1,8 @@
 // Device memory, step orchestration, gradient reduction, the non-finite guard, Adam and the per-leaf
-// statistics of the CUDA trainer (see cuda_core.h). One CUDA stream; the only host syncs of a step
-// are the read-back of the guard flag, the loss partials and the per-leaf statistics at its end.
+// statistics of the CUDA trainer (see cuda_core.h). The network part runs on one stream; the next
+// step's batch (sampling + ground truth) is drawn ahead on a second stream while it runs (prefetch,
+// see CoreConfig::prefetch). The only host syncs of a step are the read-back of the guard flag, the
+// loss partials and the per-leaf statistics at its end.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -111,11 +113,42 @@ __global__ void k_adam(float* w, float* m, float* v, uint32_t* t, __half* wh, co
     wh[i] = __float2half_rn(wi);
 }
 
+// One batch of training samples (sampling + ground truth output) with the per-draw counters of its
+// sampling pass. Two slots: the step trains one while the next step's batch is drawn into the other.
+struct BatchSlot {
+    DevBuf<float> origin, dir, len, target, points, keep;
+    DevBuf<int32_t> leaf;
+    DevBuf<uint32_t> cut, leaf_draws, scalars; // scalars: [0..1] draws (u64), [2] valid samples
+    float* keep_host = nullptr;                // pinned staging of the keep probabilities it was drawn with
+    size_t keep_host_n = 0;
+    cudaEvent_t ready{};                       // recorded after its ground truth
+    DevBatch batch{};
+    // What it holds (a prefetched batch is used only when all of these match the step).
+    bool filled = false;
+    uint32_t step = 0, n = 0;
+    uint64_t seed = 0, cut_gen = 0;
+
+    BatchSlot() = default;
+    BatchSlot(const BatchSlot&) = delete;
+    BatchSlot& operator=(const BatchSlot&) = delete;
+    ~BatchSlot() {
+        if (keep_host) cudaFreeHost(keep_host);
+        if (ready) cudaEventDestroy(ready);
+    }
+    unsigned long long* draws() { return reinterpret_cast<unsigned long long*>(scalars.p); }
+    uint32_t* valid() { return scalars.p + 2; }
+};
+
 class CoreImpl final : public Core {
 public:
     CoreImpl(const CoreAsset& a, const CoreConfig& c) : cfg_(c), scale_(c.loss_scale) {
         NBVH_CUDA_CHECK(cudaStreamCreate(&stream_));
+        NBVH_CUDA_CHECK(cudaStreamCreateWithFlags(&side_, cudaStreamNonBlocking));
         for (auto& e : ev_) NBVH_CUDA_CHECK(cudaEventCreate(&e));
+        for (BatchSlot& b : slots_) {
+            NBVH_CUDA_CHECK(cudaEventCreateWithFlags(&b.ready, cudaEventDisableTiming));
+            b.scalars.alloc(4);
+        }
         mlp_prepare();
         node_boxes_.upload(a.node_boxes);
         children_.alloc(a.node_children.size() / 2);
@@ -168,70 +201,86 @@ public:
         net_.grid_grad = grid_grad_.p;
         net_.grid_grad_fx = c.deterministic ? grid_grad_fx_.p : nullptr;
         net_.grid_values = grid_n_;
-        scalars_.alloc(4);
+        flag_.alloc(1);
         NBVH_CUDA_CHECK(cudaStreamSynchronize(stream_));
     }
     ~CoreImpl() override {
+        cudaStreamSynchronize(side_);
         cudaStreamSynchronize(stream_);
         for (auto& e : ev_) cudaEventDestroy(e);
+        cudaStreamDestroy(side_);
         cudaStreamDestroy(stream_);
     }
 
     void set_cuts(const std::vector<CoreCut>& cuts) override {
         NBVH_CHECK_SIZE(!cuts.empty() && cuts.size() <= NB_CUDA_MAX_CUTS);
+        // A batch drawn ahead on the old cuts is dropped (its leaf slots name the old cut's leaves); its
+        // sampling may still read the buffers freed below.
+        NBVH_CUDA_CHECK(cudaStreamSynchronize(side_));
+        cut_gen_++;
         cuts_.clear();
         for (size_t k = 0; k < cuts.size(); ++k) {
             cuts_.push_back(std::make_unique<DevBuf<int32_t>>());
             cuts_.back()->upload(cuts[k].leaf_of_base_node);
         }
         leaves_ = cuts[0].leaves;
-        leaf_draws_.alloc(leaves_);
         leaf_samples_.alloc(leaves_);
         leaf_loss_fx_.alloc(leaves_);
-        keep_.alloc(leaves_);
     }
 
     void step(const CoreStepIn& in, CoreStepOut& out) override {
         NBVH_CHECK_SIZE(!cuts_.empty() && in.keep_probability && in.keep_probability->size() == leaves_);
         const uint32_t n = in.batch;
-        ensure_batch(n);
+        ensure_network_batch(n);
         cudaStream_t s = stream_;
-        // Scalars: [0..1] draws (u64), [2] valid samples, [3] guard flag.
-        scalars_.zero_async(4, s);
-        unsigned long long* draws = reinterpret_cast<unsigned long long*>(scalars_.p);
-        uint32_t* valid = reinterpret_cast<uint32_t*>(scalars_.p) + 2;
-        uint32_t* flag = reinterpret_cast<uint32_t*>(scalars_.p) + 3;
-        leaf_draws_.zero_async(leaves_, s);
+        // This step's batch: the one drawn ahead by the previous step when it matches (same step, size,
+        // seed and cuts; drawn with the previous step's keep probabilities), else drawn now.
+        int cur = -1;
+        for (int k = 0; k < 2; ++k) {
+            const BatchSlot& b = slots_[k];
+            if (b.filled && b.step == in.step && b.n == n && b.seed == in.seed && b.cut_gen == cut_gen_) cur = k;
+        }
+        if (cur >= 0 && !timing_) {
+            NBVH_CUDA_CHECK(cudaStreamWaitEvent(s, slots_[cur].ready, 0));
+        } else {
+            NBVH_CUDA_CHECK(cudaStreamSynchronize(side_)); // a mismatching batch in flight may use slot 0
+            cur = 0;
+            draw_batch(slots_[cur], in.step, n, in.seed, *in.keep_probability, s);
+        }
+        for (BatchSlot& b : slots_) b.filled = false;
+        BatchSlot& slot = slots_[cur];
+        // The next step's batch, drawn while this step's network part runs (not when timing the phases).
+        if (cfg_.prefetch && !timing_) {
+            BatchSlot& next = slots_[1 - cur];
+            draw_batch(next, in.step + 1, n, in.seed, *in.keep_probability, side_);
+            next.filled = true;
+        }
+        DevBatch batch = slot.batch;
+        batch.features = b_feat_.p;
+        batch.dfeatures = b_dfeat_.p;
+        batch.loss = b_loss_.p;
+        last_slot_ = cur;
+        uint32_t* valid = slot.valid();
+        uint32_t* flag = flag_.p;
+        flag_.zero_async(1, s);
         leaf_samples_.zero_async(leaves_, s);
         leaf_loss_fx_.zero_async(leaves_, s);
-        NBVH_CUDA_CHECK(cudaMemcpyAsync(keep_.p, in.keep_probability->data(), leaves_ * 4, cudaMemcpyHostToDevice, s));
         if (cfg_.deterministic) grid_grad_fx_.zero_async(grid_n_, s);
         else grid_grad_.zero_async(grid_n_, s);
         const int blocks = mlp_blocks_for(n);
         slices_.alloc(size_t(blocks) * NB_MLP_WEIGHT_COUNT);
         slices_.zero_async(size_t(blocks) * NB_MLP_WEIGHT_COUNT, s);
 
-        DevCuts dc{};
-        dc.count = uint32_t(cuts_.size());
-        for (size_t k = 0; k < cuts_.size(); ++k) dc.leaf_of[k] = cuts_[k]->p;
-        dc.keep = keep_.p;
-        dc.leaf_draws = leaf_draws_.p;
-
-        record(0);
-        launch_sample(da_, dc, batch_, n, in.seed, in.step, draws, valid, s);
-        record(1);
-        launch_ground_truth(da_, batch_, s);
-        record(2);
-        launch_encode(net_, batch_, s);
+        launch_encode(net_, batch, s);
         record(3);
         const LossParams lp{cfg_.loss, scale_};
-        launch_mlp(net_, batch_, lp, slices_.p, blocks, flag, s);
+        launch_mlp(net_, batch, lp, slices_.p, blocks, flag, s);
         record(4);
-        launch_grid_backward(net_, batch_, cfg_.deterministic, flag, s);
+        launch_grid_backward(net_, batch, cfg_.deterministic, flag, s);
         record(5);
         const int sblocks = int((n + kStatsThreads - 1) / kStatsThreads);
         partials_.alloc(size_t(sblocks) * 6);
-        k_stats<<<sblocks, kStatsThreads, 0, s>>>(batch_, leaf_samples_.p, leaf_loss_fx_.p, partials_.p);
+        k_stats<<<sblocks, kStatsThreads, 0, s>>>(batch, leaf_samples_.p, leaf_loss_fx_.p, partials_.p);
         k_reduce_mlp<<<(NB_MLP_WEIGHT_COUNT + 255) / 256, 256, 0, s>>>(slices_.p, blocks, mlp_grad_.p, flag);
         k_check_grid<<<(grid_n_ + 255) / 256, 256, 0, s>>>(grid_grad_.p, cfg_.deterministic ? grid_grad_fx_.p : nullptr,
                                                              grid_n_, flag);
@@ -252,12 +301,13 @@ public:
         std::vector<unsigned long long> lfx(leaves_);
         out.leaf_draws.resize(leaves_);
         out.leaf_samples.resize(leaves_);
-        NBVH_CUDA_CHECK(cudaMemcpyAsync(sc, scalars_.p, 16, cudaMemcpyDeviceToHost, s));
+        NBVH_CUDA_CHECK(cudaMemcpyAsync(sc, slot.scalars.p, 12, cudaMemcpyDeviceToHost, s));
+        NBVH_CUDA_CHECK(cudaMemcpyAsync(sc + 3, flag, 4, cudaMemcpyDeviceToHost, s));
         NBVH_CUDA_CHECK(cudaMemcpyAsync(part.data(), partials_.p, part.size() * 8, cudaMemcpyDeviceToHost, s));
         NBVH_CUDA_CHECK(cudaMemcpyAsync(lfx.data(), leaf_loss_fx_.p, leaves_ * 8, cudaMemcpyDeviceToHost, s));
-        NBVH_CUDA_CHECK(cudaMemcpyAsync(out.leaf_draws.data(), leaf_draws_.p, leaves_ * 4, cudaMemcpyDeviceToHost, s));
+        NBVH_CUDA_CHECK(cudaMemcpyAsync(out.leaf_draws.data(), slot.leaf_draws.p, leaves_ * 4, cudaMemcpyDeviceToHost, s));
         NBVH_CUDA_CHECK(cudaMemcpyAsync(out.leaf_samples.data(), leaf_samples_.p, leaves_ * 4, cudaMemcpyDeviceToHost, s));
-        NBVH_CUDA_CHECK(cudaStreamSynchronize(s));
+        NBVH_CUDA_CHECK(cudaStreamSynchronize(s)); // not side_: the next batch goes on being drawn
         unsigned long long d64;
         std::memcpy(&d64, sc, 8);
         out.draws = d64;
@@ -304,16 +354,17 @@ public:
 
     void read_last(std::vector<CoreSample>& samples, std::vector<float>& mlp_grad,
                    std::vector<float>& grid_grad) const override {
-        const uint32_t n = batch_.n;
+        const DevBatch& b = slots_[last_slot_].batch;
+        const uint32_t n = b.n;
         std::vector<float> o(3 * n), d(3 * n), len(n), tg(8 * n);
         std::vector<int32_t> leaf(n);
         std::vector<uint32_t> cut(n);
-        NBVH_CUDA_CHECK(cudaMemcpy(o.data(), batch_.origin, o.size() * 4, cudaMemcpyDeviceToHost));
-        NBVH_CUDA_CHECK(cudaMemcpy(d.data(), batch_.dir, d.size() * 4, cudaMemcpyDeviceToHost));
-        NBVH_CUDA_CHECK(cudaMemcpy(len.data(), batch_.length, len.size() * 4, cudaMemcpyDeviceToHost));
-        NBVH_CUDA_CHECK(cudaMemcpy(tg.data(), batch_.target, tg.size() * 4, cudaMemcpyDeviceToHost));
-        NBVH_CUDA_CHECK(cudaMemcpy(leaf.data(), batch_.leaf, leaf.size() * 4, cudaMemcpyDeviceToHost));
-        NBVH_CUDA_CHECK(cudaMemcpy(cut.data(), batch_.cut, cut.size() * 4, cudaMemcpyDeviceToHost));
+        NBVH_CUDA_CHECK(cudaMemcpy(o.data(), b.origin, o.size() * 4, cudaMemcpyDeviceToHost));
+        NBVH_CUDA_CHECK(cudaMemcpy(d.data(), b.dir, d.size() * 4, cudaMemcpyDeviceToHost));
+        NBVH_CUDA_CHECK(cudaMemcpy(len.data(), b.length, len.size() * 4, cudaMemcpyDeviceToHost));
+        NBVH_CUDA_CHECK(cudaMemcpy(tg.data(), b.target, tg.size() * 4, cudaMemcpyDeviceToHost));
+        NBVH_CUDA_CHECK(cudaMemcpy(leaf.data(), b.leaf, leaf.size() * 4, cudaMemcpyDeviceToHost));
+        NBVH_CUDA_CHECK(cudaMemcpy(cut.data(), b.cut, cut.size() * 4, cudaMemcpyDeviceToHost));
         samples.resize(n);
         for (uint32_t i = 0; i < n; ++i) {
             CoreSample& cs = samples[i];
@@ -343,39 +394,74 @@ private:
     void record(int k) {
         if (timing_) NBVH_CUDA_CHECK(cudaEventRecord(ev_[k], stream_));
     }
-    void ensure_batch(uint32_t n) {
-        b_origin_.alloc(3 * size_t(n)); b_dir_.alloc(3 * size_t(n)); b_len_.alloc(n);
-        b_leaf_.alloc(n); b_cut_.alloc(n); b_target_.alloc(8 * size_t(n)); b_points_.alloc(9 * size_t(n));
+    void ensure_network_batch(uint32_t n) {
         b_feat_.alloc(size_t(n) * NB_MLP_INPUTS); b_dfeat_.alloc(size_t(n) * NB_MLP_INPUTS); b_loss_.alloc(5 * size_t(n));
-        batch_ = DevBatch{b_origin_.p, b_dir_.p, b_len_.p, b_leaf_.p, b_cut_.p, b_target_.p, b_points_.p,
-                          b_feat_.p, b_dfeat_.p, b_loss_.p, n};
+    }
+
+    // Sampling (first-leaf search, roulette) and ground truth of `step` into `b`, on stream `st`, with
+    // the given keep probabilities of cuts[0]; records b.ready.
+    void draw_batch(BatchSlot& b, uint32_t step, uint32_t n, uint64_t seed, const std::vector<float>& keep,
+                    cudaStream_t st) {
+        b.origin.alloc(3 * size_t(n)); b.dir.alloc(3 * size_t(n)); b.len.alloc(n);
+        b.leaf.alloc(n); b.cut.alloc(n); b.target.alloc(8 * size_t(n)); b.points.alloc(9 * size_t(n));
+        b.batch = DevBatch{b.origin.p, b.dir.p, b.len.p, b.leaf.p, b.cut.p, b.target.p, b.points.p,
+                           nullptr, nullptr, nullptr, n};
+        b.keep.alloc(leaves_);
+        b.leaf_draws.alloc(leaves_);
+        if (b.keep_host_n < leaves_) {
+            if (b.keep_host) NBVH_CUDA_CHECK(cudaFreeHost(b.keep_host));
+            b.keep_host = nullptr;
+            NBVH_CUDA_CHECK(cudaMallocHost(&b.keep_host, std::max<size_t>(leaves_, 1) * sizeof(float)));
+            b.keep_host_n = leaves_;
+        }
+        // The slot's previous copy from keep_host is done: the slot was last drawn at least one
+        // synchronised step ago, or on this stream.
+        std::memcpy(b.keep_host, keep.data(), leaves_ * sizeof(float));
+        NBVH_CUDA_CHECK(cudaMemcpyAsync(b.keep.p, b.keep_host, leaves_ * 4, cudaMemcpyHostToDevice, st));
+        b.scalars.zero_async(4, st);
+        b.leaf_draws.zero_async(leaves_, st);
+        DevCuts dc{};
+        dc.count = uint32_t(cuts_.size());
+        for (size_t k = 0; k < cuts_.size(); ++k) dc.leaf_of[k] = cuts_[k]->p;
+        dc.keep = b.keep.p;
+        dc.leaf_draws = b.leaf_draws.p;
+        if (st == stream_) record(0);
+        launch_sample(da_, dc, b.batch, n, seed, step, b.draws(), b.valid(), st);
+        if (st == stream_) record(1);
+        launch_ground_truth(da_, b.batch, st);
+        if (st == stream_) record(2);
+        NBVH_CUDA_CHECK(cudaEventRecord(b.ready, st));
+        b.step = step;
+        b.n = n;
+        b.seed = seed;
+        b.cut_gen = cut_gen_;
     }
 
     CoreConfig cfg_;
     float scale_ = 128.0f, last_scale_ = 128.0f;
     uint32_t good_steps_ = 0, last_valid_ = 0;
-    cudaStream_t stream_{};
+    cudaStream_t stream_{}, side_{}; // network part; batches drawn ahead
     cudaEvent_t ev_[7]{};
     bool timing_ = false;
     CoreTimings tm_;
     DevAsset da_{};
     DevNetwork net_{};
-    DevBatch batch_{};
+    BatchSlot slots_[2];
+    int last_slot_ = 0;
+    uint64_t cut_gen_ = 0;
     uint32_t grid_n_ = 0, leaves_ = 0;
     DevBuf<float> node_boxes_, tri_v_, tri_n_, tri_a_, tri_g_, part_boxes_, tri_uv_, srgb_;
     DevBuf<uint32_t> part_roots_, texels_, tex_info_;
     DevBuf<int32_t> tri_tex_;
     DevBuf<uint2> children_;
     DevBuf<GpuBvhNode> mesh_nodes_;
-    DevBuf<float> grid_w_, grid_m_, grid_v_, grid_grad_, mlp_w_, mlp_m_, mlp_v_, mlp_grad_, slices_, keep_;
-    DevBuf<uint32_t> grid_t_, mlp_t_, leaf_draws_, leaf_samples_, scalars_;
+    DevBuf<float> grid_w_, grid_m_, grid_v_, grid_grad_, mlp_w_, mlp_m_, mlp_v_, mlp_grad_, slices_;
+    DevBuf<uint32_t> grid_t_, mlp_t_, leaf_samples_, flag_;
     DevBuf<__half> grid_h_, mlp_h_, b_feat_;
     DevBuf<unsigned long long> grid_grad_fx_, leaf_loss_fx_;
     DevBuf<double> partials_;
     std::vector<std::unique_ptr<DevBuf<int32_t>>> cuts_;
-    DevBuf<float> b_origin_, b_dir_, b_len_, b_target_, b_points_, b_dfeat_, b_loss_;
-    DevBuf<int32_t> b_leaf_;
-    DevBuf<uint32_t> b_cut_;
+    DevBuf<float> b_dfeat_, b_loss_; // features (b_feat_ above), dL/dfeature and losses: network part only
 };
 
 } // namespace

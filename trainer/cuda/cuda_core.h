@@ -51,6 +51,10 @@ struct CoreConfig {
     GpuLossConfig loss{2.0f, 2.0f, 1.0f, 1.0f, 1u, 1u};
     bool deterministic = false;
     float loss_scale = 128.0f;          // initial per-sample loss scale (power of two)
+    // Draw the next step's batch (sampling + ground truth, with this step's keep probabilities) on a
+    // second stream while this step's network part runs. The batch is used when the next step has the
+    // same step index, batch size, seed and cuts; otherwise it is dropped and the batch drawn anew.
+    bool prefetch = true;
 };
 
 struct CoreCut {
