@@ -8,11 +8,25 @@
 namespace nbvh::cuda {
 namespace {
 
+// 1 / d per axis, computed once per ray: clip_line_to_box's `1.0f / d` (IEEE division, so the same value
+// as dividing per box; 0 where d is 0, which clip_dilated tests before using it).
+struct InvDir { float v[3]; };
+__device__ InvDir inv_dir(vec3 d) {
+    InvDir r;
+    for (int a = 0; a < 3; ++a) r.v[a] = d[a] != 0.0f ? 1.0f / d[a] : 0.0f;
+    return r;
+}
+
 // trainer/training_rays.cpp clip_line_to_box on a box dilated as dilate_box() (same float operations).
-__device__ bool clip_dilated(const float* box, vec3 o, vec3 d, float dilation, float& t_entry, float& t_exit) {
+// The box (lo xyz, hi xyz; 24 bytes, 8-byte aligned) is read as three float2 through the read-only cache.
+__device__ bool clip_dilated(const float* box, vec3 o, vec3 d, const InvDir& id, float dilation, float& t_entry,
+                             float& t_exit) {
+    const float2* b2 = reinterpret_cast<const float2*>(box);
+    const float2 p0 = __ldg(b2), p1 = __ldg(b2 + 1), p2 = __ldg(b2 + 2);
+    const float lo3[3] = {p0.x, p0.y, p1.x}, hi3[3] = {p1.y, p2.x, p2.y};
     float t0 = -NB_INF, t1 = NB_INF;
     for (int a = 0; a < 3; ++a) {
-        const float blo = box[a], bhi = box[3 + a];
+        const float blo = lo3[a], bhi = hi3[a];
         if (blo > bhi) return false; // empty box
         const float c = 0.5f * (blo + bhi);
         const float half = 0.5f * (bhi - blo) * (1.0f + dilation);
@@ -23,7 +37,7 @@ __device__ bool clip_dilated(const float* box, vec3 o, vec3 d, float dilation, f
             if (oa < lo || oa > hi) return false;
             continue;
         }
-        const float inv = 1.0f / da;
+        const float inv = id.v[a];
         float ta = (lo - oa) * inv, tb = (hi - oa) * inv;
         if (ta > tb) { const float t = ta; ta = tb; tb = t; }
         t0 = ta > t0 ? ta : t0;
@@ -40,13 +54,14 @@ struct Found { int32_t leaf; float t_entry, t_exit; };
 // first_leaf_of_cut: nearest-first descent of the base BVH, stopping at cut leaves.
 __device__ Found first_leaf(const DevAsset& a, const int32_t* leaf_of, vec3 o, vec3 d, float dilation, uint32_t root) {
     Found best{-1, 0.0f, 0.0f};
+    const InvDir id = inv_dir(d);
     float best_entry = NB_INF;
     uint32_t st_node[NB_BVH_MAX_DEPTH * 2 + 2];
     float st_t[NB_BVH_MAX_DEPTH * 2 + 2];
     int top = 0;
     float t0, t1;
     if (a.base_nodes == 0) return best;
-    if (!clip_dilated(a.node_boxes + size_t(root) * 6, o, d, dilation, t0, t1) || t1 <= a.min_exit) return best;
+    if (!clip_dilated(a.node_boxes + size_t(root) * 6, o, d, id, dilation, t0, t1) || t1 <= a.min_exit) return best;
     st_node[top] = root;
     st_t[top++] = t0;
     while (top > 0) {
@@ -57,7 +72,7 @@ __device__ Found first_leaf(const DevAsset& a, const int32_t* leaf_of, vec3 o, v
         const int32_t slot = leaf_of[node];
         if (slot >= 0) {
             float ea = 0.0f, eb = 0.0f;
-            clip_dilated(a.node_boxes + size_t(node) * 6, o, d, dilation, ea, eb);
+            clip_dilated(a.node_boxes + size_t(node) * 6, o, d, id, dilation, ea, eb);
             best = Found{slot, ea, eb};
             best_entry = te;
             continue;
@@ -71,7 +86,7 @@ __device__ Found first_leaf(const DevAsset& a, const int32_t* leaf_of, vec3 o, v
         for (int k = 0; k < 2; ++k) {
             const uint32_t child = kids[k];
             if (child == 0xFFFFFFFFu) continue;
-            if (clip_dilated(a.node_boxes + size_t(child) * 6, o, d, dilation, t0, t1) && t1 > a.min_exit &&
+            if (clip_dilated(a.node_boxes + size_t(child) * 6, o, d, id, dilation, t0, t1) && t1 > a.min_exit &&
                 t0 < best_entry) {
                 kn[count] = child;
                 kt[count++] = t0;
