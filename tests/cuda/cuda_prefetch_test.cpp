@@ -25,6 +25,9 @@ struct StepRun {
 struct StepInput {
     const TrainingCut* cut;
     uint64_t cut_version;
+    uint32_t step = ~0u; // ~0: the input's index
+    uint32_t batch = 3000;
+    uint64_t seed = 5;
 };
 
 StepRun run_steps(const TrainingAsset& asset, bool prefetch, const std::vector<StepInput>& steps) {
@@ -35,9 +38,9 @@ StepRun run_steps(const TrainingAsset& asset, bool prefetch, const std::vector<S
     StepRun r;
     for (uint32_t s = 0; s < steps.size(); ++s) {
         StepParams p;
-        p.step = s;
-        p.batch_size = 3000;
-        p.seed = 5;
+        p.step = steps[s].step == ~0u ? s : steps[s].step;
+        p.batch_size = steps[s].batch;
+        p.seed = steps[s].seed;
         p.cuts = {steps[s].cut};
         p.cut_version = steps[s].cut_version;
         r.stats.push_back(b->step(p));
@@ -101,6 +104,27 @@ TEST(CudaPrefetch, CutChangeDropsTheBatchDrawnAhead) {
         expect_same_samples(with.samples[s], without.samples[s]);
         ASSERT_EQ(with.stats[s].leaves.size(), steps[s].cut->size());
         for (const CudaDebugSample& x : with.samples[s]) ASSERT_LT(x.leaf, int32_t(steps[s].cut->size()));
+    }
+    EXPECT_EQ(with.weights.mlp, without.weights.mlp);
+    EXPECT_EQ(with.weights.grid, without.weights.grid);
+}
+
+// A batch drawn ahead is used only for the step index, batch size and seed it was drawn for: a trainer
+// that repeats or skips a step index, or changes the batch or the seed, gets a batch drawn anew.
+TEST(CudaPrefetch, OtherStepBatchOrSeedDrawsAnew) {
+    REQUIRE_GPU();
+    Scene scene;
+    const TrainingAsset asset = height_field_asset(scene);
+    TrainingCut cut = test::cut_at_depth(asset, 5);
+    for (size_t i = 0; i < cut.size(); ++i) cut.keep_probability[i] = i % 4 == 0 ? 0.3f : 1.0f;
+    auto in = [&](uint32_t step, uint32_t batch, uint64_t seed) { return StepInput{&cut, 1, step, batch, seed}; };
+    const std::vector<StepInput> steps{in(0, 3000, 5), in(1, 3000, 5), in(1, 3000, 5), in(2, 2000, 5),
+                                       in(3, 4000, 5), in(4, 4000, 6), in(7, 4000, 6), in(8, 4000, 6)};
+    const StepRun with = run_steps(asset, true, steps), without = run_steps(asset, false, steps);
+    for (size_t s = 0; s < steps.size(); ++s) {
+        SCOPED_TRACE("call " + std::to_string(s));
+        ASSERT_EQ(with.samples[s].size(), steps[s].batch);
+        expect_same_samples(with.samples[s], without.samples[s]);
     }
     EXPECT_EQ(with.weights.mlp, without.weights.mlp);
     EXPECT_EQ(with.weights.grid, without.weights.grid);

@@ -22,7 +22,7 @@ struct CudaBackendOptions {
     float loss_scale = 128.0f; // per-sample loss scale of the fp16 backward (halved on overflow)
     // Draw step k+1's rays and ground truth while step k's network part runs (a second stream). Step
     // k+1 then samples with step k's keep probabilities (one step older than without prefetch); a cut
-    // change drops the batch drawn ahead. Same rays otherwise (cuda_backend_test.cpp).
+    // change drops the batch drawn ahead. Same rays otherwise (tests/cuda/cuda_prefetch_test.cpp).
     bool prefetch = true;
 };
 
