@@ -10,7 +10,7 @@
 
 #include "engine/neural/losses.h"
 #include "engine/scene/gltf_loader.h"
-#include "tests/cuda/cuda_test_cuts.h"
+#include "tests/cuda/cuda_test_support.h"
 #include "tests/support/test_support.h"
 #include "tests/trainer/trainer_test_scenes.h"
 #include "trainer/cpu/cpu_backend.h"
@@ -20,11 +20,6 @@
 
 namespace nbvh {
 namespace {
-
-#define REQUIRE_GPU()                                                                            \
-    do {                                                                                         \
-        if (!cuda_backend_available()) GTEST_SKIP() << "no usable CUDA GPU";                    \
-    } while (0)
 
 using test::cut_at_depth;
 

@@ -4,17 +4,12 @@
 // step's rays are drawn on the new cut); a changed keep vector takes effect one step later. Skip without a GPU.
 #include <gtest/gtest.h>
 
-#include "tests/cuda/cuda_test_cuts.h"
+#include "tests/cuda/cuda_test_support.h"
 #include "tests/trainer/trainer_test_scenes.h"
 #include "trainer/cuda/cuda_backend.h"
 
 namespace nbvh {
 namespace {
-
-#define REQUIRE_GPU()                                                                            \
-    do {                                                                                         \
-        if (!cuda_backend_available()) GTEST_SKIP() << "no usable CUDA GPU";                    \
-    } while (0)
 
 struct StepRun {
     std::vector<std::vector<CudaDebugSample>> samples; // per step
@@ -63,6 +58,19 @@ void expect_same_samples(const std::vector<CudaDebugSample>& a, const std::vecto
     }
 }
 
+// Every call's samples, and the final weights, equal between the runs with and without prefetch.
+void expect_same_runs(const StepRun& with, const StepRun& without, const std::vector<StepInput>& steps) {
+    for (size_t s = 0; s < steps.size(); ++s) {
+        SCOPED_TRACE("call " + std::to_string(s));
+        ASSERT_EQ(with.samples[s].size(), steps[s].batch);
+        expect_same_samples(with.samples[s], without.samples[s]);
+        ASSERT_EQ(with.stats[s].leaves.size(), steps[s].cut->size());
+        for (const CudaDebugSample& x : with.samples[s]) ASSERT_LT(x.leaf, int32_t(steps[s].cut->size()));
+    }
+    EXPECT_EQ(with.weights.mlp, without.weights.mlp);
+    EXPECT_EQ(with.weights.grid, without.weights.grid);
+}
+
 TrainingAsset height_field_asset(Scene& scene) {
     scene = test::scene_of(test::height_field(32, 0.2f, 1.0f, glm::vec3(0.0f)));
     return make_training_asset(scene, 0);
@@ -76,9 +84,9 @@ TEST(CudaPrefetch, SameRaysAndWeightsAsWithoutPrefetch) {
     for (size_t i = 0; i < cut.size(); ++i) cut.keep_probability[i] = i % 3 == 0 ? 0.25f : 1.0f; // roulette redraws
     const std::vector<StepInput> steps(5, StepInput{&cut, 1});
     const StepRun with = run_steps(asset, true, steps), without = run_steps(asset, false, steps);
-    for (size_t s = 0; s < steps.size(); ++s) {
+    expect_same_runs(with, without, steps);
+    for (size_t s = 0; s < steps.size(); ++s) { // and the statistics the host splits by
         SCOPED_TRACE("step " + std::to_string(s));
-        expect_same_samples(with.samples[s], without.samples[s]);
         EXPECT_EQ(with.stats[s].draws, without.stats[s].draws);
         EXPECT_EQ(with.stats[s].loss.total, without.stats[s].loss.total);
         ASSERT_EQ(with.stats[s].leaves.size(), without.stats[s].leaves.size());
@@ -87,8 +95,6 @@ TEST(CudaPrefetch, SameRaysAndWeightsAsWithoutPrefetch) {
             EXPECT_EQ(with.stats[s].leaves[i].samples, without.stats[s].leaves[i].samples);
         }
     }
-    EXPECT_EQ(with.weights.mlp, without.weights.mlp);
-    EXPECT_EQ(with.weights.grid, without.weights.grid);
 }
 
 TEST(CudaPrefetch, CutChangeDropsTheBatchDrawnAhead) {
@@ -98,15 +104,7 @@ TEST(CudaPrefetch, CutChangeDropsTheBatchDrawnAhead) {
     const TrainingCut coarse = test::cut_at_depth(asset, 3), fine = test::cut_at_depth(asset, 6);
     ASSERT_NE(coarse.size(), fine.size());
     const std::vector<StepInput> steps{{&coarse, 1}, {&fine, 2}, {&fine, 2}, {&coarse, 3}};
-    const StepRun with = run_steps(asset, true, steps), without = run_steps(asset, false, steps);
-    for (size_t s = 0; s < steps.size(); ++s) {
-        SCOPED_TRACE("step " + std::to_string(s));
-        expect_same_samples(with.samples[s], without.samples[s]);
-        ASSERT_EQ(with.stats[s].leaves.size(), steps[s].cut->size());
-        for (const CudaDebugSample& x : with.samples[s]) ASSERT_LT(x.leaf, int32_t(steps[s].cut->size()));
-    }
-    EXPECT_EQ(with.weights.mlp, without.weights.mlp);
-    EXPECT_EQ(with.weights.grid, without.weights.grid);
+    expect_same_runs(run_steps(asset, true, steps), run_steps(asset, false, steps), steps);
 }
 
 // A batch drawn ahead is used only for the step index, batch size and seed it was drawn for: a trainer
@@ -120,14 +118,7 @@ TEST(CudaPrefetch, OtherStepBatchOrSeedDrawsAnew) {
     auto in = [&](uint32_t step, uint32_t batch, uint64_t seed) { return StepInput{&cut, 1, step, batch, seed}; };
     const std::vector<StepInput> steps{in(0, 3000, 5), in(1, 3000, 5), in(1, 3000, 5), in(2, 2000, 5),
                                        in(3, 4000, 5), in(4, 4000, 6), in(7, 4000, 6), in(8, 4000, 6)};
-    const StepRun with = run_steps(asset, true, steps), without = run_steps(asset, false, steps);
-    for (size_t s = 0; s < steps.size(); ++s) {
-        SCOPED_TRACE("call " + std::to_string(s));
-        ASSERT_EQ(with.samples[s].size(), steps[s].batch);
-        expect_same_samples(with.samples[s], without.samples[s]);
-    }
-    EXPECT_EQ(with.weights.mlp, without.weights.mlp);
-    EXPECT_EQ(with.weights.grid, without.weights.grid);
+    expect_same_runs(run_steps(asset, true, steps), run_steps(asset, false, steps), steps);
 }
 
 // The batch of step k+1 is drawn during step k with step k's keep probabilities: a new keep vector

@@ -1,10 +1,18 @@
-// Shared by the CUDA trainer tests: a fixed N-BVH cut of a training asset.
+// Shared by the CUDA trainer tests: the skip without a GPU and a fixed N-BVH cut of a training asset.
 #pragma once
 #include <cstdint>
 #include <vector>
 
+#include <gtest/gtest.h>
+
+#include "trainer/cuda/cuda_backend.h"
 #include "trainer/training_asset.h"
 #include "trainer/training_rays.h"
+
+#define REQUIRE_GPU()                                                                            \
+    do {                                                                                         \
+        if (!::nbvh::cuda_backend_available()) GTEST_SKIP() << "no usable CUDA GPU";            \
+    } while (0)
 
 namespace nbvh::test {
 
