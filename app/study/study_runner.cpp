@@ -68,6 +68,9 @@ struct CameraSide {
     double noise_floor = 0.0, classical_ms = 0.0;
     std::unique_ptr<WavefrontRenderer> classical; // image size: reference, floor, equal-time renders
     std::map<uint32_t, double> equal_time_flip;   // classical spp -> FLIP vs the reference
+    // Samples of the compared seed in `classical`'s film (the floor render, then equal-time extensions);
+    // 0 when the film holds something else.
+    uint32_t film_spp = 0;
 };
 
 class StudyRun {
@@ -214,6 +217,7 @@ void StudyRun::classical_side() {
         RenderOptions same = image_options(o_.render.spp, o_.render.seed);
         same.neural.classical = true;
         cam.floor_px = as_png_pixels(render_with(*cam.classical, same).image, cam.exposure);
+        cam.film_spp = o_.render.spp;
         cam.noise_floor = flip_ldr(cam.ref_px, cam.floor_px).mean;
         std::unique_ptr<WavefrontRenderer> timing;
         if (separate_timing()) {
@@ -244,18 +248,35 @@ void StudyRun::classical_side() {
 }
 
 // FLIP of a classical render of `cam` in the time the hybrid needs (ratio x the compared spp; rounded to
-// eighths of it, so nearby ratios share one render).
+// eighths of it, so nearby ratios share one render). The equal-time images of a camera are prefixes of
+// one sample sequence (the compared seed, samples 0..spp-1, the floor render's first `spp`), so the film
+// left by the floor render is extended eighth by eighth up to the request, caching the FLIP of every
+// eighth on the way: a sweep renders each camera's classical samples once instead of once per distinct
+// spp. A request below the film (or a film that holds something else) is rendered anew.
 double StudyRun::equal_time(CameraSide& cam, double ratio, uint32_t* spp_out) {
+    const uint32_t base = o_.render.spp;
+    auto spp_of = [&](uint32_t eighths) { return std::max(1u, uint32_t((uint64_t(base) * eighths + 4) / 8)); };
     const uint32_t eighths = uint32_t(std::max(1.0, std::round(8.0 * ratio)));
-    const uint32_t spp = std::max(1u, uint32_t((uint64_t(o_.render.spp) * eighths + 4) / 8));
+    const uint32_t spp = spp_of(eighths);
     *spp_out = spp;
     if (auto it = cam.equal_time_flip.find(spp); it != cam.equal_time_flip.end()) return it->second;
-    RenderOptions opt = image_options(spp, o_.render.seed);
-    opt.neural.classical = true;
-    const double flip =
-        flip_ldr(cam.ref_px, as_png_pixels(render_with(*cam.classical, opt).image, cam.exposure)).mean;
-    cam.equal_time_flip[spp] = flip;
-    return flip;
+    auto flip_of = [&](const Image& linear) { return flip_ldr(cam.ref_px, as_png_pixels(linear, cam.exposure)).mean; };
+    const bool extend = cam.film_spp > 0 && cam.film_spp < spp && cam.classical->accumulated_samples() == cam.film_spp;
+    if (!extend) {
+        RenderOptions opt = image_options(spp, o_.render.seed);
+        opt.neural.classical = true;
+        cam.equal_time_flip[spp] = flip_of(render_with(*cam.classical, opt).image);
+        cam.film_spp = spp;
+        return cam.equal_time_flip[spp];
+    }
+    for (uint32_t e = 1; cam.film_spp < spp; ++e) {
+        const uint32_t next = spp_of(e);
+        if (next <= cam.film_spp) continue;
+        const Image mean = cam.classical->render_progressive(next - cam.film_spp).image;
+        cam.film_spp = next;
+        if (!cam.equal_time_flip.count(next)) cam.equal_time_flip[next] = flip_of(mean);
+    }
+    return cam.equal_time_flip.at(spp);
 }
 
 void StudyRun::run_config(size_t index, const Config& c) {

@@ -71,6 +71,26 @@ TEST(Progressive, OneSampleAtATimeEqualsOneRender) {
     EXPECT_EQ(ctx.validation_message_count(), 0);
 }
 
+// A film left by render() goes on with render_progressive: the samples after it are the one-shot render's
+// next ones (the study extends its floor render to the equal-time spp this way). 20 + 13 samples cross
+// the multi-sample waves (up to 16 samples of a small image per wave) unaligned.
+TEST(Progressive, RenderThenMoreSamplesEqualsOneLongerRender) {
+    const Fixture& f = fixture();
+    vk::Context ctx = make_context();
+    const Camera cam = auto_frame(f.scene, 1.5f);
+    render::WavefrontRenderer once(ctx, f.scene, f.accel, f.env, cam, small_options(33));
+    const render::RenderResult ref = once.render();
+
+    render::WavefrontRenderer film(ctx, f.scene, f.accel, f.env, cam, small_options(20));
+    const render::RenderResult first = film.render();
+    const render::RenderResult more = film.render_progressive(13);
+    EXPECT_EQ(film.accumulated_samples(), 33u);
+    EXPECT_EQ(more.stats.spp, 33u);
+    EXPECT_LT(max_abs_diff(more.image, ref.image), 1e-5);
+    EXPECT_GT(max_abs_diff(first.image, ref.image), 1e-4); // control: 20 samples are not 33
+    EXPECT_EQ(ctx.validation_message_count(), 0);
+}
+
 TEST(Progressive, SetCameraRestartsWithTheNewView) {
     const Fixture& f = fixture();
     vk::Context ctx = make_context();
