@@ -3,51 +3,11 @@
 // of each sample by a closest-hit traversal of the asset's triangle BVH in the shared GpuBvhNode layout
 // with the shared ray/box and ray/triangle tests (shaders/shared/intersect.h).
 // Compiled with --fmad=false (CMakeLists.txt) so the ray set matches the CPU backend's for a seed.
+#include "trainer/cuda/clip_box.cuh"
 #include "trainer/cuda/device_common.cuh"
 
 namespace nbvh::cuda {
 namespace {
-
-// 1 / d per axis, computed once per ray: clip_line_to_box's `1.0f / d` (IEEE division, so the same value
-// as dividing per box; 0 where d is 0, which clip_dilated tests before using it).
-struct InvDir { float v[3]; };
-__device__ InvDir inv_dir(vec3 d) {
-    InvDir r;
-    for (int a = 0; a < 3; ++a) r.v[a] = d[a] != 0.0f ? 1.0f / d[a] : 0.0f;
-    return r;
-}
-
-// trainer/training_rays.cpp clip_line_to_box on a box dilated as dilate_box() (same float operations).
-// The box (lo xyz, hi xyz; 24 bytes, 8-byte aligned) is read as three float2 through the read-only cache.
-__device__ bool clip_dilated(const float* box, vec3 o, vec3 d, const InvDir& id, float dilation, float& t_entry,
-                             float& t_exit) {
-    const float2* b2 = reinterpret_cast<const float2*>(box);
-    const float2 p0 = __ldg(b2), p1 = __ldg(b2 + 1), p2 = __ldg(b2 + 2);
-    const float lo3[3] = {p0.x, p0.y, p1.x}, hi3[3] = {p1.y, p2.x, p2.y};
-    float t0 = -NB_INF, t1 = NB_INF;
-    for (int a = 0; a < 3; ++a) {
-        const float blo = lo3[a], bhi = hi3[a];
-        if (blo > bhi) return false; // empty box
-        const float c = 0.5f * (blo + bhi);
-        const float half = 0.5f * (bhi - blo) * (1.0f + dilation);
-        const float lo = c - half, hi = c + half;
-        if (!isfinite(lo) || !isfinite(hi)) return false;
-        const float oa = o[a], da = d[a];
-        if (da == 0.0f) {
-            if (oa < lo || oa > hi) return false;
-            continue;
-        }
-        const float inv = id.v[a];
-        float ta = (lo - oa) * inv, tb = (hi - oa) * inv;
-        if (ta > tb) { const float t = ta; ta = tb; tb = t; }
-        t0 = ta > t0 ? ta : t0;
-        t1 = tb < t1 ? tb : t1;
-    }
-    if (!(t0 <= t1) || !isfinite(t0) || !isfinite(t1)) return false;
-    t_entry = t0;
-    t_exit = t1;
-    return true;
-}
 
 struct Found { int32_t leaf; float t_entry, t_exit; };
 

@@ -1,0 +1,46 @@
+// Kernel of clip_box_kernels.h: one thread per case, inv_dir + clip_dilated exactly as k_sample calls
+// them. Compiled with --fmad=false like sampling_kernels.cu (tests/cuda/CMakeLists.txt).
+#include "tests/cuda/clip_box_kernels.h"
+#include "trainer/cuda/clip_box.cuh"
+
+namespace nbvh::test {
+namespace {
+
+__global__ void k_clip(ClipCase* cases, const float* boxes, uint32_t n) {
+    const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= n) return;
+    ClipCase& c = cases[i];
+    const vec3 o(c.origin[0], c.origin[1], c.origin[2]), d(c.dir[0], c.dir[1], c.dir[2]);
+    const cuda::InvDir id = cuda::inv_dir(d);
+    float t0 = 0.0f, t1 = 0.0f;
+    c.hit = cuda::clip_dilated(boxes + 6 * size_t(i), o, d, id, c.dilation, t0, t1) ? 1u : 0u;
+    c.t_entry = c.hit ? t0 : 0.0f;
+    c.t_exit = c.hit ? t1 : 0.0f;
+}
+
+std::string error_of(cudaError_t e) { return e == cudaSuccess ? std::string() : std::string(cudaGetErrorString(e)); }
+
+} // namespace
+
+std::string clip_on_device(std::vector<ClipCase>& cases) {
+    const uint32_t n = uint32_t(cases.size());
+    std::vector<float> boxes(6 * size_t(n));
+    for (uint32_t i = 0; i < n; ++i)
+        for (int k = 0; k < 6; ++k) boxes[6 * size_t(i) + k] = cases[i].box[k];
+    ClipCase* dc = nullptr;
+    float* db = nullptr;
+    std::string err = error_of(cudaMalloc(&dc, n * sizeof(ClipCase)));
+    if (err.empty()) err = error_of(cudaMalloc(&db, boxes.size() * sizeof(float)));
+    if (err.empty()) err = error_of(cudaMemcpy(dc, cases.data(), n * sizeof(ClipCase), cudaMemcpyHostToDevice));
+    if (err.empty()) err = error_of(cudaMemcpy(db, boxes.data(), boxes.size() * sizeof(float), cudaMemcpyHostToDevice));
+    if (err.empty()) {
+        k_clip<<<(n + 127) / 128, 128>>>(dc, db, n);
+        err = error_of(cudaGetLastError());
+    }
+    if (err.empty()) err = error_of(cudaMemcpy(cases.data(), dc, n * sizeof(ClipCase), cudaMemcpyDeviceToHost));
+    cudaFree(dc);
+    cudaFree(db);
+    return err;
+}
+
+} // namespace nbvh::test
