@@ -15,6 +15,7 @@ void add_info_command(CLI::App& app);
 void add_bench_command(CLI::App& app, const std::string& command_line);
 void add_bench_features_command(CLI::App& app, const std::string& command_line);
 void add_study_command(CLI::App& app, const std::string& command_line);
+void add_converge_command(CLI::App& app, const std::string& command_line);
 void add_view_command(CLI::App& app);
 
 } // namespace nbvh::app

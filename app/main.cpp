@@ -1,4 +1,4 @@
-// nbvh: neural BVH renderer. Subcommands: render, train, flip, info, bench, bench-features, study, view.
+// nbvh: neural BVH renderer. Subcommands: render, train, flip, info, bench, bench-features, study, converge, view.
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
     nbvh::app::add_bench_command(app, command);
     nbvh::app::add_bench_features_command(app, command);
     nbvh::app::add_study_command(app, command);
+    nbvh::app::add_converge_command(app, command);
     nbvh::app::add_view_command(app);
     try {
         app.parse(argc, argv);

@@ -64,7 +64,9 @@ struct Config {
 struct CameraSide {
     Camera camera;
     float exposure = 0.0f;  // stops of every PNG of this camera (the reference's auto exposure)
-    Image ref_px, floor_px; // reference (ref_spp) and classical (spp, compared seed), as PNG pixels
+    // The reference (ref_spp) and the classical image (spp, compared seed) as PNG pixels, prepared once
+    // for the FLIPs of every row (FlipReference: the same figures as flip_ldr, half the filtering).
+    std::optional<FlipReference> ref_flip, floor_flip;
     double noise_floor = 0.0, classical_ms = 0.0;
     std::unique_ptr<WavefrontRenderer> classical; // image size: reference, floor, equal-time renders
     std::map<uint32_t, double> equal_time_flip;   // classical spp -> FLIP vs the reference
@@ -212,13 +214,15 @@ void StudyRun::classical_side() {
         render::RenderResult r = cam.classical->render();
         device_ = r.stats.device, driver_ = r.stats.driver;
         cam.exposure = fixed_exposure_ ? *fixed_exposure_ : auto_exposure(r.image).stops;
-        cam.ref_px = as_png_pixels(r.image, cam.exposure);
+        const Image ref_px = as_png_pixels(r.image, cam.exposure);
         if (o_.save_images && c == 0) save("reference_cam0.png", r.image, cam.exposure);
         RenderOptions same = image_options(o_.render.spp, o_.render.seed);
         same.neural.classical = true;
-        cam.floor_px = as_png_pixels(render_with(*cam.classical, same).image, cam.exposure);
+        const Image floor_px = as_png_pixels(render_with(*cam.classical, same).image, cam.exposure);
         cam.film_spp = o_.render.spp;
-        cam.noise_floor = flip_ldr(cam.ref_px, cam.floor_px).mean;
+        cam.ref_flip.emplace(ref_px);
+        cam.floor_flip.emplace(floor_px);
+        cam.noise_floor = cam.ref_flip->compare(floor_px).mean;
         std::unique_ptr<WavefrontRenderer> timing;
         if (separate_timing()) {
             RenderOptions t = timing_options();
@@ -260,7 +264,7 @@ double StudyRun::equal_time(CameraSide& cam, double ratio, uint32_t* spp_out) {
     const uint32_t spp = spp_of(eighths);
     *spp_out = spp;
     if (auto it = cam.equal_time_flip.find(spp); it != cam.equal_time_flip.end()) return it->second;
-    auto flip_of = [&](const Image& linear) { return flip_ldr(cam.ref_px, as_png_pixels(linear, cam.exposure)).mean; };
+    auto flip_of = [&](const Image& linear) { return cam.ref_flip->compare(as_png_pixels(linear, cam.exposure)).mean; };
     const bool extend = cam.film_spp > 0 && cam.film_spp < spp && cam.classical->accumulated_samples() == cam.film_spp;
     if (!extend) {
         RenderOptions opt = image_options(spp, o_.render.seed);
@@ -403,9 +407,9 @@ void StudyRun::run_config(size_t index, const Config& c) {
                                                                  double(res.stats.rays_total())
                                                            : 0.0;
             kernel_ = res.stats.neural_path;
-            row.flip = flip_ldr(cam.ref_px, px).mean;
+            row.flip = cam.ref_flip->compare(px).mean;
             row.noise_floor = cam.noise_floor;
-            row.flip_same_seed = flip_ldr(cam.floor_px, px).mean;
+            row.flip_same_seed = cam.floor_flip->compare(px).mean;
             if (v.kind == "lod" && v.lod == 0) base_px = px;
             if (v.kind == "cap" && base_px.width) row.flip_vs_base_cap = flip_ldr(base_px, px).mean;
             if (v.equal_time)
@@ -438,9 +442,9 @@ void StudyRun::run_config(size_t index, const Config& c) {
             row.ratio_to_classical = row.frame_ms / cam.classical_ms;
             const render::RenderResult res = render_with(*dr, dopt);
             const Image px = as_png_pixels(res.image, cam.exposure);
-            row.flip = flip_ldr(cam.ref_px, px).mean;
+            row.flip = cam.ref_flip->compare(px).mean;
             row.noise_floor = cam.noise_floor;
-            row.flip_same_seed = flip_ldr(cam.floor_px, px).mean;
+            row.flip_same_seed = cam.floor_flip->compare(px).mean;
             mark_floor(row);
             if (o_.save_images && index == 0 && ci == 0) save("decimated_cam0.png", res.image, cam.exposure);
             rows_.push_back(row);

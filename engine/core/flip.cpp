@@ -116,11 +116,23 @@ float hyab(const float a[3], const float b[3]) {
     return std::fabs(a[0] - b[0]) + std::sqrt(da * da + db * db);
 }
 
+} // namespace
+
 // CSF-filtered, Hunt-adjusted Lab planes and the feature magnitudes of one image (§6.2, §6.3).
-struct Prepared {
+struct FlipPrepared {
     Plane lab[3];
     Plane edge, point;
 };
+
+namespace {
+using Prepared = FlipPrepared;
+
+// out = sqrt(a^2 + b^2) per pixel (`out` already sized).
+void magnitude(const Plane& a, const Plane& b, Plane& out, int w, int h) {
+    parallel_rows(h, [&](int y0, int y1) {
+        for (size_t i = size_t(y0) * w; i < size_t(y1) * w; ++i) out[i] = std::sqrt(a[i] * a[i] + b[i] * b[i]);
+    });
+}
 
 // `rgb` is interleaved with `channels` floats per pixel; values are clamped to [0,1] (NaN -> 0).
 Prepared prepare(const float* rgb, int channels, int w, int h, const FlipKernels& k) {
@@ -169,7 +181,9 @@ Prepared prepare(const float* rgb, int channels, int w, int h, const FlipKernels
 
     // §6.3: features on the unfiltered, normalised achromatic channel.
     Plane& yhat = ycc[1]; // reuse storage
-    for (size_t i = 0; i < n; ++i) yhat[i] = (ycc[0][i] + 16.0f) / 116.0f;
+    parallel_rows(h, [&](int y0, int y1) {
+        for (size_t i = size_t(y0) * w; i < size_t(y1) * w; ++i) yhat[i] = (ycc[0][i] + 16.0f) / 116.0f;
+    });
     Plane gx, dx, ddx, a, b;
     conv_x(yhat, gx, w, h, k.g);
     conv_x(yhat, dx, w, h, k.dg);
@@ -177,20 +191,16 @@ Prepared prepare(const float* rgb, int channels, int w, int h, const FlipKernels
     conv_y(dx, a, w, h, k.g);  // edge x: G' along x, G along y
     conv_y(gx, b, w, h, k.dg); // edge y: G along x, G' along y
     out.edge.resize(n);
-    for (size_t i = 0; i < n; ++i) out.edge[i] = std::sqrt(a[i] * a[i] + b[i] * b[i]);
+    magnitude(a, b, out.edge, w, h);
     conv_y(ddx, a, w, h, k.g);
     conv_y(gx, b, w, h, k.ddg);
     out.point.resize(n);
-    for (size_t i = 0; i < n; ++i) out.point[i] = std::sqrt(a[i] * a[i] + b[i] * b[i]);
+    magnitude(a, b, out.point, w, h);
     return out;
 }
 
-// LDR-FLIP map of two interleaved RGB buffers of the same size (§6.2-6.4).
-std::vector<float> ldr_map(const float* ref, int ref_channels, const float* test, int test_channels, int w, int h,
-                           const FlipKernels& k) {
-    const Prepared r = prepare(ref, ref_channels, w, h, k);
-    const Prepared t = prepare(test, test_channels, w, h, k);
-
+// LDR-FLIP map of two prepared images of the same size (§6.2.6-6.4).
+std::vector<float> ldr_map(const Prepared& r, const Prepared& t, int w, int h) {
     // §6.2.7: the largest colour difference, green vs blue.
     float green[3] = {0.0f, 1.0f, 0.0f}, blue[3] = {0.0f, 0.0f, 1.0f}, lg[3], lb[3];
     rgb_to_hunt_lab(green, lg);
@@ -199,19 +209,27 @@ std::vector<float> ldr_map(const float* ref, int ref_channels, const float* test
     const float pccmax = PC * cmax;
     const float inv_sqrt2 = 1.0f / std::sqrt(2.0f);
 
-    const size_t n = size_t(w) * size_t(h);
-    std::vector<float> map(n);
-    for (size_t i = 0; i < n; ++i) {
-        const float a[3] = {r.lab[0][i], r.lab[1][i], r.lab[2][i]};
-        const float b[3] = {t.lab[0][i], t.lab[1][i], t.lab[2][i]};
-        const float de = std::pow(hyab(a, b), QC);
-        const float dc = de < pccmax ? (PT / pccmax) * de : PT + ((de - pccmax) / (cmax - pccmax)) * (1.0f - PT);
-        const float edge = std::fabs(r.edge[i] - t.edge[i]);
-        const float point = std::fabs(r.point[i] - t.point[i]);
-        const float df = std::pow(inv_sqrt2 * std::max(edge, point), QF);
-        map[i] = std::pow(dc, 1.0f - df);
-    }
+    std::vector<float> map(size_t(w) * size_t(h));
+    parallel_rows(h, [&](int y0, int y1) {
+        for (size_t i = size_t(y0) * w; i < size_t(y1) * w; ++i) {
+            const float a[3] = {r.lab[0][i], r.lab[1][i], r.lab[2][i]};
+            const float b[3] = {t.lab[0][i], t.lab[1][i], t.lab[2][i]};
+            const float de = std::pow(hyab(a, b), QC);
+            const float dc =
+                de < pccmax ? (PT / pccmax) * de : PT + ((de - pccmax) / (cmax - pccmax)) * (1.0f - PT);
+            const float edge = std::fabs(r.edge[i] - t.edge[i]);
+            const float point = std::fabs(r.point[i] - t.point[i]);
+            const float df = std::pow(inv_sqrt2 * std::max(edge, point), QF);
+            map[i] = std::pow(dc, 1.0f - df);
+        }
+    });
     return map;
+}
+
+// LDR-FLIP map of two interleaved RGB buffers of the same size (§6.2-6.4).
+std::vector<float> ldr_map(const float* ref, int ref_channels, const float* test, int test_channels, int w, int h,
+                           const FlipKernels& k) {
+    return ldr_map(prepare(ref, ref_channels, w, h, k), prepare(test, test_channels, w, h, k), w, h);
 }
 
 // §5: float accumulation in row-major order, like the official tool's pooling<float>.
@@ -296,6 +314,34 @@ FlipResult flip_ldr(const Image& reference, const Image& test, float ppd) {
     res.height = reference.height;
     res.error = ldr_map(reference.data.data(), reference.channels, test.data.data(), test.channels, res.width,
                         res.height, k);
+    res.mean = float_mean(res.error);
+    return res;
+}
+
+FlipReference::FlipReference(const Image& reference, float ppd) {
+    if (reference.empty()) throw Error("FLIP: empty image");
+    if (reference.channels < 3) throw Error("FLIP: images need 3 or 4 channels (RGB/RGBA)");
+    if (!(ppd > 0.0f) || !std::isfinite(ppd)) throw Error(strfmt("FLIP: invalid pixels per degree %g", double(ppd)));
+    width_ = reference.width;
+    height_ = reference.height;
+    channels_ = reference.channels;
+    kernels_ = std::make_shared<const FlipKernels>(flip_kernels(ppd));
+    prepared_ = std::make_shared<const FlipPrepared>(
+        prepare(reference.data.data(), reference.channels, width_, height_, *kernels_));
+}
+
+FlipResult FlipReference::compare(const Image& test) const {
+    Image shape; // check_pair's messages, without copying the reference
+    shape.width = width_;
+    shape.height = height_;
+    shape.channels = channels_;
+    shape.data.resize(1);
+    check_pair(shape, test);
+    FlipResult res;
+    res.width = width_;
+    res.height = height_;
+    res.error = ldr_map(*prepared_, prepare(test.data.data(), test.channels, width_, height_, *kernels_), width_,
+                        height_);
     res.mean = float_mean(res.error);
     return res;
 }

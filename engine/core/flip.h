@@ -8,6 +8,7 @@
 // Images may have 3 or 4 channels (alpha is ignored); reference and test must have the same size.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -30,6 +31,24 @@ struct FlipResult {
 };
 
 FlipResult flip_ldr(const Image& reference, const Image& test, float ppd = flip_ppd());
+
+// One reference prepared once (colour transforms, CSF and feature filters) for LDR-FLIP against many test
+// images: compare(test) equals flip_ldr(reference, test, ppd) bit for bit and filters one image instead of
+// two (the study and `nbvh converge` compare each reference with every row's image). Copies share the
+// prepared planes; the reference image itself is not kept.
+struct FlipPrepared;
+class FlipReference {
+  public:
+    explicit FlipReference(const Image& reference, float ppd = flip_ppd());
+    FlipResult compare(const Image& test) const;
+    int width() const { return width_; }
+    int height() const { return height_; }
+
+  private:
+    int width_ = 0, height_ = 0, channels_ = 0;
+    std::shared_ptr<const struct FlipKernels> kernels_;
+    std::shared_ptr<const FlipPrepared> prepared_;
+};
 
 // HDR-FLIP tone mappers (flip.md §6.4).
 enum class FlipToneMapper { aces, hable, reinhard };

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <numeric>
+#include <tuple>
 
 #include "engine/core/error.h"
 #include "engine/core/flip.h"
@@ -239,4 +241,44 @@ TEST(Flip, HeatmapEndsAreMagma) {
     ASSERT_EQ(px.size(), 6u);
     EXPECT_LT(px[0] + px[1] + px[2], 10);         // near black
     EXPECT_GT(px[3] + px[4] + px[5], 3 * 230 - 60); // pale yellow
+}
+
+// A prepared reference gives flip_ldr's map and mean bit for bit: several test images against one
+// reference, a multi-threaded size and a single-band one (under 64 rows), RGB test against an RGBA
+// reference, NaN and out-of-range pixels, another ppd; copies share the prepared planes; size and
+// channel mismatches throw as flip_ldr does.
+TEST(Flip, PreparedReferenceMatchesFlipLdrBitForBit) {
+    uint32_t state = 12345u;
+    auto next = [&] { state = state * 1664525u + 1013904223u; return float(state >> 8) / float(1u << 24); };
+    for (const auto [w, h, ppd] : {std::tuple{160, 97, flip_ppd()}, std::tuple{37, 23, 20.0f}}) {
+        Image ref(w, h, 4);
+        for (float& v : ref.data) v = next();
+        ref.at(3, 4)[0] = std::nanf("");
+        ref.at(5, 6)[1] = 7.0f;
+        const FlipReference prepared(ref, ppd);
+        const FlipReference copy = prepared;
+        EXPECT_EQ(prepared.width(), w);
+        EXPECT_EQ(prepared.height(), h);
+        for (int k = 0; k < 3; ++k) {
+            Image test(w, h, k == 2 ? 3 : 4);
+            for (size_t i = 0; i < test.data.size(); ++i) {
+                const size_t px = i / size_t(test.channels), c = i % size_t(test.channels);
+                const float r = ref.data[px * 4 + c];
+                test.data[i] = (std::isfinite(r) ? r : 0.5f) + (k == 0 ? 0.0f : 0.2f * (next() - 0.5f));
+            }
+            test.data[7] = -1.0f;
+            const FlipResult a = flip_ldr(ref, test, ppd);
+            const FlipResult b = (k == 1 ? copy : prepared).compare(test);
+            ASSERT_EQ(a.error.size(), b.error.size());
+            EXPECT_EQ(0, std::memcmp(a.error.data(), b.error.data(), a.error.size() * sizeof(float))) << w << " " << k;
+            EXPECT_EQ(a.mean, b.mean);
+            EXPECT_EQ(b.width, w);
+            EXPECT_EQ(b.height, h);
+        }
+    }
+    const FlipReference p(pattern(16, 16, 1.0f));
+    EXPECT_THROW(p.compare(pattern(16, 17, 1.0f)), Error);
+    EXPECT_THROW(p.compare(Image(16, 16, 1)), Error);
+    EXPECT_THROW(FlipReference(Image{}), Error);
+    EXPECT_THROW(FlipReference(pattern(8, 8, 1.0f), 0.0f), Error);
 }

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# GPU-machine run of `nbvh converge` (issue 11: is the study's shared-seed FLIP the converged one?): for
+# each scene, the model `nbvh train` makes by default (CUDA), then hybrid and classical images of one seed
+# extended from FROM to SPP samples against a REF_SPP classical reference, at the study's image size
+# (960x540, max depth 8) and camera 0 (the scene's own, the dragon auto-framed, Chess the paper's).
+# Usage (after `source .device/env.sh`): scripts/bench/converge.sh OUT [default] [dragon] [chess]
+# Env: NBVH (binary, default .device/study/bin/nbvh, xz-packed allowed), FROM (128), SPP (8192),
+#      REF_SPP (32768). Writes OUT/SCENE.json, OUT/SCENE.csv and OUT/log.txt (the tables).
+# Estimated on the H100 from the study's frame times: ~5 minutes for the three scenes.
+# Plot afterwards, on the build machine: scripts/bench/plot_convergence.py OUT/*.json results/study/convergence.png
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+OUT=$1
+shift
+SCENES=("$@")
+[ ${#SCENES[@]} -gt 0 ] || SCENES=(default dragon chess)
+NBVH=${NBVH:-.device/study/bin/nbvh}
+mkdir -p "$OUT"
+TMP=${TMPDIR:-/tmp}/nbvh_converge
+mkdir -p "$TMP"
+unpack() { # SRC.xz DST: xz, else Python's lzma
+  if command -v xz >/dev/null; then xz -dc "$1" > "$2"
+  else python3 -c 'import lzma, shutil, sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2], "wb"))' "$1" "$2"; fi
+}
+if [ ! -x "$NBVH" ] && [ -f "$NBVH.xz" ]; then
+  unpack "$NBVH.xz" "$TMP/nbvh" && chmod +x "$TMP/nbvh" && NBVH=$TMP/nbvh
+fi
+{
+  nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null || echo "no nvidia-smi"
+  for WHICH in "${SCENES[@]}"; do
+    case "$WHICH" in
+      default) SCENE=(default); VIEW=() ;;
+      dragon)
+        unpack .device/study/dragon/dragon_vrip.glb.xz "$TMP/dragon_vrip.glb"
+        SCENE=("$TMP/dragon_vrip.glb"); VIEW=() ;;
+      chess)
+        unpack .device/study/chess/abeautifulgame.glb.xz "$TMP/abeautifulgame.glb"
+        SCENE=("$TMP/abeautifulgame.glb")
+        VIEW=(--camera 0.600,0.358,0.179,-0.197,-0.197,-0.057,45 --env .device/study/chess/photo_studio_loft_hall_512x256.hdr
+              --env-rotation 285 --exposure 0) ;;
+      *) echo "converge.sh: scene must be default, dragon or chess" >&2; exit 2 ;;
+    esac
+    NEURAL=()
+    [ "$WHICH" = dragon ] && NEURAL=(--neural '*')
+    echo "== $WHICH"
+    t0=$(date +%s)
+    "$NBVH" train "${SCENE[@]}" "${NEURAL[@]}" --backend cuda --out "$TMP/$WHICH.nbvh" 2>&1 | grep -v "^step " | tail -3
+    "$NBVH" converge "${SCENE[@]}" --model "$TMP/$WHICH.nbvh" "${VIEW[@]}" --device gpu --width 960 --height 540 \
+      --max-depth 8 --from "${FROM:-128}" --spp "${SPP:-8192}" --ref-spp "${REF_SPP:-32768}" \
+      --json "$OUT/$WHICH.json" --csv "$OUT/$WHICH.csv"
+    echo "$WHICH: $(( $(date +%s) - t0 )) s"
+  done
+} 2>&1 | tee "$OUT/log.txt"
