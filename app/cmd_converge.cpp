@@ -28,6 +28,7 @@
 #include "app/output_path.h"
 #include "app/render_args.h"
 #include "app/scene_arg.h"
+#include "app/study/study_options.h"
 #include "engine/bvh/scene_accel.h"
 #include "engine/core/error.h"
 #include "engine/core/exposure.h"
@@ -40,9 +41,6 @@
 
 namespace nbvh::app {
 namespace {
-
-// The reference's seed offset (the study's: any seed other than the compared images').
-constexpr uint32_t REFERENCE_SEED_OFFSET = 1000003;
 
 struct ConvergeArgs {
     std::string scene, model, device = "auto", json, csv, neural_path = "auto", camera, env, exposure = "auto",
@@ -123,7 +121,7 @@ void run_converge(const ConvergeArgs& a) {
     // The reference: the true scene at ref_spp with its own seed.
     render::RenderOptions ref_opt = classical;
     ref_opt.spp = ref_spp;
-    ref_opt.seed = base.seed + REFERENCE_SEED_OFFSET;
+    ref_opt.seed = base.seed + STUDY_REFERENCE_SEED_OFFSET;
     log_info("converge: classical reference, %u spp", ref_spp);
     const render::RenderResult ref = [&] {
         render::WavefrontRenderer r(ctx, scene, accel, env, camera, ref_opt);

@@ -10,6 +10,10 @@
 
 namespace nbvh::app {
 
+// The seed of a study's (and `nbvh converge`'s) classical reference is the compared images' seed plus this:
+// any other seed would do, the reference's noise must be independent of theirs.
+inline constexpr uint32_t STUDY_REFERENCE_SEED_OFFSET = 1000003;
+
 struct StudyOptions {
     std::string scene, neural_glob, asset_glob, out_dir;
     std::string env, device = "auto", backend = "auto", exposure = "auto";

@@ -1,0 +1,213 @@
+// One configuration of a study: train a model in-process, decimate the neural meshes to its bytes, and
+// from every camera render each variant (every LoD, the LoD switch, the raised leaf budget) and the
+// decimated meshes: frame time, image, FLIP beside the noise floor, memory, the equal-time baseline.
+// Renderers are built once per model for all cameras and switched between rows with apply().
+#include "app/study/study_run.h"
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <thread>
+
+#include "app/output_path.h"
+#include "app/render_args.h"
+#include "app/render_measure.h"
+#include "app/study/study_cameras.h"
+#include "app/study/study_progress.h"
+#include "app/study/study_rows.h"
+#include "app/training_scene.h"
+#include "engine/bvh/scene_accel.h"
+#include "engine/core/error.h"
+#include "engine/core/exposure.h"
+#include "engine/core/flip.h"
+#include "engine/core/log.h"
+#include "engine/neural/asset_table.h"
+#include "engine/render/decimation.h"
+#include "engine/render/gpu_memory.h"
+#include "engine/render/wavefront.h"
+#include "engine/vk/context.h"
+#include "trainer/compact_hash.h"
+#include "trainer/model_export.h"
+#include "trainer/trainer.h"
+#if defined(NBVH_HAVE_CUDA)
+#include "trainer/cuda/cuda_backend.h"
+#endif
+
+namespace nbvh::app::study {
+
+void StudyRun::run_config(size_t index, const Config& c) {
+    // Train.
+    TrainOptions opt = default_train_options(backend_);
+    opt.target_nodes = c.nodes;
+    opt.network.log2_hash_size = c.hash_log2;
+    if (o_.steps) opt.steps = *o_.steps;
+    if (o_.batch) opt.batch_size = *o_.batch;
+    opt.lods = o_.lods;
+    opt.seed = o_.train_seed;
+    opt.threads = o_.threads;
+    validate(opt);
+    const std::string label =
+        strfmt("config %zu/%zu (nodes %u, hash 2^%u)", index + 1, configs_.size(), c.nodes, c.hash_log2);
+    progress_.begin(StudyTask::train, double(opt.steps) * opt.batch_size, label + ": training");
+    const TrainResult tr = [&] { // the backend (its GPU memory) is gone before the renders
+        std::unique_ptr<TrainerBackend> be = make_backend(backend_, *asset_, opt);
+        return train_asset(*asset_, opt, *be, [&](const TrainProgress& p) {
+            progress_.partial(double(p.step) / double(std::max(1u, p.steps)));
+        });
+    }();
+    const NeuralModel model = make_neural_model(*asset_, tr, opt, o_.scene, ts_.source_hash);
+    const render::NeuralGpuBytes bytes = render::neural_gpu_bytes(model);
+    progress_.end(strfmt("%u nodes, %s, final loss %.4f, %.1f s", tr.tree.node_count(),
+                         strfmt("%.2f MiB", double(bytes.total()) / 1048576.0).c_str(),
+                         tr.log.back().loss.total, tr.seconds));
+    config_json_.push_back({{"config", index},
+                            {"nodes_target", c.nodes},
+                            {"hash_log2", c.hash_log2},
+                            {"nodes", tr.tree.node_count()},
+                            {"lod_node_counts", model.lod_node_counts},
+                            {"train_seconds", tr.seconds},
+                            {"train_steps", opt.steps},
+                            {"train_batch", opt.batch_size},
+                            {"final_loss", tr.log.back().loss.total},
+                            {"skipped_steps", tr.skipped_steps},
+                            {"neural_bytes",
+                             {{"total", bytes.total()},
+                              {"grid", bytes.grid},
+                              {"mlp", bytes.mlp},
+                              {"mlp_transposed", bytes.mlp_transposed},
+                              {"levels", bytes.levels},
+                              {"nodes", bytes.nodes},
+                              {"node_bounds", bytes.node_bounds},
+                              {"assets", bytes.assets},
+                              {"params", bytes.params}}}});
+
+    // The scene as the model sees it (its asset table decides which instances are neural).
+    Scene hybrid_scene = ts_.scene;
+    bind_model_to_scene(hybrid_scene, model, "the study's model");
+    const uint32_t lods = std::max(1u, model.lod_count);
+    const std::vector<Variant> variants = variants_of(index, lods);
+
+    // The equal-memory baseline: the neural meshes simplified to the bytes of the LoD-0 model.
+    std::optional<render::Decimation> dec;
+    std::optional<SceneAccel> dec_accel;
+    if (o_.decimation) {
+        dec = render::decimate_to_budget(ts_.scene, ts_.meshes, bytes.total_for_lod(0));
+        dec_accel = build_scene_accel(dec->scene);
+    }
+
+    // One renderer per image size for every camera (set_camera), for the model and for the decimated
+    // scene: building one (scene upload, pipelines) costs about as much as a variant's renders.
+    RenderOptions ho = image_options(o_.render.spp, o_.render.seed);
+    ho.neural.model = &model;
+    WavefrontRenderer hybrid(*ctx_, hybrid_scene, accel_, env_, cams_.front().camera, ho);
+    std::unique_ptr<WavefrontRenderer> timing;
+    if (separate_timing()) {
+        RenderOptions t = timing_options();
+        t.neural.model = &model;
+        timing = std::make_unique<WavefrontRenderer>(*ctx_, hybrid_scene, accel_, env_, cams_.front().camera, t);
+    }
+    RenderOptions dopt = image_options(o_.render.spp, o_.render.seed);
+    dopt.neural.classical = true;
+    std::unique_ptr<WavefrontRenderer> dr, dtiming;
+    if (dec) {
+        dr = std::make_unique<WavefrontRenderer>(*ctx_, dec->scene, *dec_accel, env_, cams_.front().camera, dopt);
+        if (separate_timing()) {
+            RenderOptions t = timing_options();
+            t.neural.classical = true;
+            dtiming = std::make_unique<WavefrontRenderer>(*ctx_, dec->scene, *dec_accel, env_, cams_.front().camera, t);
+        }
+    }
+    for (size_t ci = 0; ci < cams_.size(); ++ci) {
+        CameraSide& cam = cams_[ci];
+        for (WavefrontRenderer* r : {&hybrid, timing.get(), dr.get(), dtiming.get()})
+            if (r) r->set_camera(cam.camera);
+        Image base_px;
+        for (const Variant& v : variants) {
+            RenderOptions vo = ho;
+            vo.neural.lod = uint32_t(v.lod);
+            vo.neural.secondary_lod = v.secondary;
+            vo.neural.max_rounds = v.max_leaves;
+            const std::string what =
+                v.kind == "switch" ? strfmt("LoD %d, then %d after the first hit", v.lod, v.secondary)
+                : v.kind == "cap"  ? strfmt("LoD %d, <= %u leaves per ray", v.lod, v.max_leaves)
+                                   : strfmt("LoD %d", v.lod);
+            progress_.begin(StudyTask::render, variant_work(v.equal_time),
+                            strfmt("%s, camera %zu: %s", label.c_str(), ci, what.c_str()));
+            StudyRow row;
+            row.config = int(index);
+            row.variant = v.kind;
+            row.camera = int(ci);
+            row.nodes_target = c.nodes;
+            row.hash_log2 = c.hash_log2;
+            row.lods = lods;
+            row.lod = v.lod;
+            row.secondary_lod = v.secondary;
+            row.max_leaves = v.max_leaves;
+            row.nodes = model.lod_node_counts.empty() ? 0 : model.lod_node_counts[size_t(v.lod)];
+            row.memory_bytes = bytes.total_for_lod(uint32_t(v.lod));
+            row.resident_bytes = bytes.total();
+            row.compression = double(source_bytes_) / double(row.memory_bytes);
+            row.train_seconds = tr.seconds;
+            row.final_loss = tr.log.back().loss.total;
+            row.frame_ms = time_frame(hybrid, timing.get(), vo);
+            row.classical_frame_ms = cam.classical_ms;
+            row.ratio_to_classical = row.frame_ms / cam.classical_ms;
+            const render::RenderResult res = render_with(hybrid, vo);
+            const Image px = as_png_pixels(res.image, cam.exposure);
+            row.queries_per_ray = res.stats.neural_queries_per_ray();
+            row.leaf_cap_fraction = res.stats.rays_total() ? double(res.stats.neural_leaf_cap_rays) /
+                                                                 double(res.stats.rays_total())
+                                                           : 0.0;
+            kernel_ = res.stats.neural_path;
+            row.flip = cam.ref_flip->compare(px).mean;
+            row.noise_floor = cam.noise_floor;
+            row.flip_same_seed = cam.floor_flip->compare(px).mean;
+            if (v.kind == "lod" && v.lod == 0) base_px = px;
+            if (v.kind == "cap" && base_px.width) row.flip_vs_base_cap = flip_ldr(base_px, px).mean;
+            if (v.equal_time)
+                row.equal_time_flip = equal_time(cam, row.ratio_to_classical, &row.equal_time_spp);
+            mark_floor(row);
+            if (o_.save_images && index == 0 && ci == 0 && v.kind == "lod" && v.lod == 0)
+                save("hybrid_cam0.png", res.image, cam.exposure);
+            rows_.push_back(row);
+            progress_.end(strfmt("FLIP %.4f (floor %.4f%s), %.2fx classical, %.2f MiB", row.flip,
+                                 row.noise_floor, row.within_2x_floor ? ", within 2x floor" : "",
+                                 row.ratio_to_classical, double(row.memory_bytes) / 1048576.0));
+        }
+        if (dec) {
+            progress_.begin(StudyTask::render, pixel_samples(o_.render.spp) + timing_work(),
+                            strfmt("%s, camera %zu: decimated to %llu triangles", label.c_str(), ci,
+                                   (unsigned long long)dec->triangles));
+            StudyRow row;
+            row.config = int(index);
+            row.variant = "decimated";
+            row.camera = int(ci);
+            row.nodes_target = c.nodes;
+            row.hash_log2 = c.hash_log2;
+            row.lods = lods;
+            row.memory_bytes = row.resident_bytes = dec->bytes;
+            row.triangles = dec->triangles;
+            row.compression = double(source_bytes_) / double(dec->bytes);
+            row.decimation_sloppy = dec->sloppy;
+            row.frame_ms = time_frame(*dr, dtiming.get(), dopt);
+            row.classical_frame_ms = cam.classical_ms;
+            row.ratio_to_classical = row.frame_ms / cam.classical_ms;
+            const render::RenderResult res = render_with(*dr, dopt);
+            const Image px = as_png_pixels(res.image, cam.exposure);
+            row.flip = cam.ref_flip->compare(px).mean;
+            row.noise_floor = cam.noise_floor;
+            row.flip_same_seed = cam.floor_flip->compare(px).mean;
+            mark_floor(row);
+            if (o_.save_images && index == 0 && ci == 0) save("decimated_cam0.png", res.image, cam.exposure);
+            rows_.push_back(row);
+            progress_.end(strfmt("FLIP %.4f (floor %.4f), %.2f MiB (%+.1f %% of the model's)", row.flip,
+                                 row.noise_floor, double(dec->bytes) / 1048576.0,
+                                 100.0 * dec->relative_error()));
+        }
+    }
+}
+
+} // namespace nbvh::app::study
