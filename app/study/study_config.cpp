@@ -4,6 +4,8 @@
 // Renderers are built once per model for all cameras and switched between rows with apply().
 #include "app/study/study_run.h"
 
+#include <future>
+
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -90,13 +92,24 @@ void StudyRun::run_config(size_t index, const Config& c) {
     const uint32_t lods = std::max(1u, model.lod_count);
     const std::vector<Variant> variants = variants_of(index, lods);
 
-    // The equal-memory baseline: the neural meshes simplified to the bytes of the LoD-0 model.
-    std::optional<render::Decimation> dec;
-    std::optional<SceneAccel> dec_accel;
-    if (o_.decimation) {
-        dec = render::decimate_to_budget(ts_.scene, ts_.meshes, bytes.total_for_lod(0));
-        dec_accel = build_scene_accel(dec->scene);
-    }
+    // The equal-memory baseline: the neural meshes simplified to the bytes of the LoD-0 model, with its
+    // BVHs. CPU work (about a second on the default scene): it runs on a worker thread while camera 0's
+    // variants render, and is taken before camera 0's decimated row. The worker only reads ts_.
+    struct Decimated {
+        render::Decimation dec;
+        SceneAccel accel;
+        double seconds = 0.0;
+    };
+    std::future<Decimated> dec_job;
+    if (o_.decimation)
+        dec_job = std::async(std::launch::async, [this, budget = bytes.total_for_lod(0)] {
+            const auto t0 = std::chrono::steady_clock::now();
+            Decimated d{render::decimate_to_budget(ts_.scene, ts_.meshes, budget), {}, 0.0};
+            d.accel = build_scene_accel(d.dec.scene);
+            d.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            return d;
+        });
+    std::optional<Decimated> decimated; // outlives the renderers below, which keep its scene and BVHs
 
     // One renderer per image size for every camera (set_camera), for the model and for the decimated
     // scene: building one (scene upload, pipelines) costs about as much as a variant's renders.
@@ -111,15 +124,18 @@ void StudyRun::run_config(size_t index, const Config& c) {
     }
     RenderOptions dopt = image_options(o_.render.spp, o_.render.seed);
     dopt.neural.classical = true;
-    std::unique_ptr<WavefrontRenderer> dr, dtiming;
-    if (dec) {
-        dr = std::make_unique<WavefrontRenderer>(*ctx_, dec->scene, *dec_accel, env_, cams_.front().camera, dopt);
+    std::unique_ptr<WavefrontRenderer> dr, dtiming; // built when the decimation is done
+    auto take_decimation = [&](const Camera& camera) {
+        decimated.emplace(dec_job.get());
+        config_json_.back()["decimation_seconds"] = decimated->seconds;
+        const render::Decimation& d = decimated->dec;
+        dr = std::make_unique<WavefrontRenderer>(*ctx_, d.scene, decimated->accel, env_, camera, dopt);
         if (separate_timing()) {
             RenderOptions t = timing_options();
             t.neural.classical = true;
-            dtiming = std::make_unique<WavefrontRenderer>(*ctx_, dec->scene, *dec_accel, env_, cams_.front().camera, t);
+            dtiming = std::make_unique<WavefrontRenderer>(*ctx_, d.scene, decimated->accel, env_, camera, t);
         }
-    }
+    };
     for (size_t ci = 0; ci < cams_.size(); ++ci) {
         CameraSide& cam = cams_[ci];
         for (WavefrontRenderer* r : {&hybrid, timing.get(), dr.get(), dtiming.get()})
@@ -177,7 +193,9 @@ void StudyRun::run_config(size_t index, const Config& c) {
                                  row.noise_floor, row.within_2x_floor ? ", within 2x floor" : "",
                                  row.ratio_to_classical, double(row.memory_bytes) / 1048576.0));
         }
-        if (dec) {
+        if (o_.decimation) {
+            if (!decimated) take_decimation(cam.camera);
+            const render::Decimation* dec = &decimated->dec;
             progress_.begin(StudyTask::render, pixel_samples(o_.render.spp) + timing_work(),
                             strfmt("%s, camera %zu: decimated to %llu triangles", label.c_str(), ci,
                                    (unsigned long long)dec->triangles));

@@ -134,6 +134,8 @@ TEST(Study, TinySweepWritesCsvJsonAndPlots) {
     for (const auto& c : j["configs"]) {
         EXPECT_GT(c["neural_bytes"]["total"].get<uint64_t>(), c["neural_bytes"]["grid"].get<uint64_t>());
         EXPECT_EQ(c["lod_node_counts"].size(), 2u);
+        ASSERT_TRUE(c.contains("decimation_seconds")) << c.dump(); // the worker thread's meshoptimizer + BVHs
+        EXPECT_GT(c["decimation_seconds"].get<double>(), 0.0);
     }
     // Decimated rows: the meshes at the bytes of the LoD-0 model, within 5 %.
     std::map<int, uint64_t> lod0_bytes;
