@@ -60,7 +60,11 @@ void StudyRun::run_config(size_t index, const Config& c) {
             progress_.partial(double(p.step) / double(std::max(1u, p.steps)));
         });
     }();
-    const NeuralModel model = make_neural_model(*asset_, tr, opt, o_.scene, ts_.source_hash);
+    // The renderers still point at the last configuration's model until their first apply() below: it
+    // stays alive (previous_model_), so the new one has another address and apply() swaps it in.
+    previous_model_ = std::move(model_);
+    model_ = std::make_unique<NeuralModel>(make_neural_model(*asset_, tr, opt, o_.scene, ts_.source_hash));
+    const NeuralModel& model = *model_;
     const render::NeuralGpuBytes bytes = render::neural_gpu_bytes(model);
     progress_.end(strfmt("%u nodes, %s, final loss %.4f, %.1f s", tr.tree.node_count(),
                          strfmt("%.2f MiB", double(bytes.total()) / 1048576.0).c_str(),
@@ -86,9 +90,12 @@ void StudyRun::run_config(size_t index, const Config& c) {
                               {"assets", bytes.assets},
                               {"params", bytes.params}}}});
 
-    // The scene as the model sees it (its asset table decides which instances are neural).
-    Scene hybrid_scene = ts_.scene;
-    bind_model_to_scene(hybrid_scene, model, "the study's model");
+    // The scene as the models see it (their asset table decides which instances are neural): every
+    // configuration learns the same assets, so it is bound once; apply() checks each model against it.
+    if (!hybrid_scene_) {
+        hybrid_scene_.emplace(ts_.scene);
+        bind_model_to_scene(*hybrid_scene_, model, "the study's model");
+    }
     const uint32_t lods = std::max(1u, model.lod_count);
     const std::vector<Variant> variants = variants_of(index, lods);
 
@@ -111,17 +118,21 @@ void StudyRun::run_config(size_t index, const Config& c) {
         });
     std::optional<Decimated> decimated; // outlives the renderers below, which keep its scene and BVHs
 
-    // One renderer per image size for every camera (set_camera), for the model and for the decimated
-    // scene: building one (scene upload, pipelines) costs about as much as a variant's renders.
+    // One renderer per image size for every camera (set_camera): building one (scene upload, pipelines)
+    // costs about as much as a variant's renders. The hybrid ones serve the whole sweep (the model is
+    // swapped in by the rows' apply(): an upload); the decimated scene's are this configuration's.
     RenderOptions ho = image_options(o_.render.spp, o_.render.seed);
     ho.neural.model = &model;
-    WavefrontRenderer hybrid(*ctx_, hybrid_scene, accel_, env_, cams_.front().camera, ho);
-    std::unique_ptr<WavefrontRenderer> timing;
-    if (separate_timing()) {
+    if (!hybrid_)
+        hybrid_ = std::make_unique<WavefrontRenderer>(*ctx_, *hybrid_scene_, accel_, env_, cams_.front().camera, ho);
+    if (separate_timing() && !hybrid_timing_) {
         RenderOptions t = timing_options();
         t.neural.model = &model;
-        timing = std::make_unique<WavefrontRenderer>(*ctx_, hybrid_scene, accel_, env_, cams_.front().camera, t);
+        hybrid_timing_ =
+            std::make_unique<WavefrontRenderer>(*ctx_, *hybrid_scene_, accel_, env_, cams_.front().camera, t);
     }
+    WavefrontRenderer& hybrid = *hybrid_;
+    WavefrontRenderer* timing = hybrid_timing_.get();
     RenderOptions dopt = image_options(o_.render.spp, o_.render.seed);
     dopt.neural.classical = true;
     std::unique_ptr<WavefrontRenderer> dr, dtiming; // built when the decimation is done
@@ -138,7 +149,7 @@ void StudyRun::run_config(size_t index, const Config& c) {
     };
     for (size_t ci = 0; ci < cams_.size(); ++ci) {
         CameraSide& cam = cams_[ci];
-        for (WavefrontRenderer* r : {&hybrid, timing.get(), dr.get(), dtiming.get()})
+        for (WavefrontRenderer* r : {&hybrid, timing, dr.get(), dtiming.get()})
             if (r) r->set_camera(cam.camera);
         Image base_px;
         for (const Variant& v : variants) {
@@ -168,7 +179,7 @@ void StudyRun::run_config(size_t index, const Config& c) {
             row.compression = double(source_bytes_) / double(row.memory_bytes);
             row.train_seconds = tr.seconds;
             row.final_loss = tr.log.back().loss.total;
-            row.frame_ms = time_frame(hybrid, timing.get(), vo);
+            row.frame_ms = time_frame(hybrid, timing, vo);
             row.classical_frame_ms = cam.classical_ms;
             row.ratio_to_classical = row.frame_ms / cam.classical_ms;
             const render::RenderResult res = render_with(hybrid, vo);

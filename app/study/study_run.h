@@ -18,6 +18,7 @@
 #include "app/training_scene.h"
 #include "engine/bvh/scene_accel.h"
 #include "engine/core/flip.h"
+#include "engine/neural/model_file.h"
 #include "engine/render/wavefront.h"
 #include "engine/vk/context.h"
 #include "trainer/trainer.h"
@@ -124,6 +125,12 @@ class StudyRun {
     nlohmann::json config_json_ = nlohmann::json::array();
     std::string started_, stop_reason_;
     size_t configs_done_ = 0;
+    // One hybrid renderer (and one for the timed frames) for the whole sweep, declared last so they go
+    // before the context, scene and BVHs they use: each configuration's model is swapped in through
+    // apply(), its scene bound once; the previous model lives until the renderers have left it.
+    std::optional<Scene> hybrid_scene_;
+    std::unique_ptr<NeuralModel> model_, previous_model_;
+    std::unique_ptr<WavefrontRenderer> hybrid_, hybrid_timing_;
 };
 
 } // namespace nbvh::app::study

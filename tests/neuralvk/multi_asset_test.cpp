@@ -365,3 +365,51 @@ TEST(MultiAsset, ModelSwapMatchesAFreshRenderer) {
     EXPECT_EQ(live.model_swaps(), 2u);
     EXPECT_EQ(ctx.validation_message_count(), 0);
 }
+
+// `nbvh study` keeps one hybrid renderer for its whole sweep and swaps each configuration's model in:
+// a model of the same assets trained with another node budget, hash size and LoD count (other buffer
+// sizes, another cut) renders through apply() exactly as a fresh renderer with it, and back.
+TEST(MultiAsset, ModelOfAnotherShapeSwapsLikeAFreshRenderer) {
+    const Trained& t = trained();
+    TrainOptions opt = default_train_options(BackendChoice::cpu);
+    opt.steps = 60;
+    opt.batch_size = 1024;
+    opt.target_nodes = 120;
+    opt.network.log2_hash_size = 12;
+    opt.lods = 2;
+    opt.threads = 2;
+    const NeuralModel other = [&] {
+        auto backend = make_backend(BackendChoice::cpu, t.asset, opt);
+        return make_neural_model(t.asset, train_asset(t.asset, opt, *backend), opt, "multi_asset_test", 0);
+    }();
+    ASSERT_NE(other.lod_count, t.model.lod_count);
+    ASSERT_NE(other.grid.size(), t.model.grid.size());
+    Scene scene = make_scene();
+    bind_model_to_scene(scene, t.model, "m.nbvh");
+    vk::Context ctx(lavapipe());
+    const SceneAccel accel = build_scene_accel(scene);
+    RenderOptions o;
+    o.width = o.height = 40;
+    o.spp = 2;
+    o.max_depth = 3;
+    o.seed = 5;
+    o.neural.path = NeuralPath::scalar;
+    o.neural.model = &t.model;
+    o.neural.secondary_lod = SECONDARY_LOD_COARSEST;
+    RenderOptions swapped = o;
+    swapped.neural.model = &other;
+    auto fresh = [&](const RenderOptions& opt) {
+        WavefrontRenderer r(ctx, scene, accel, default_sky(), scene.camera, opt);
+        return r.render().image;
+    };
+    WavefrontRenderer live(ctx, scene, accel, default_sky(), scene.camera, o);
+    const Image a = live.render().image;
+    ASSERT_TRUE(live.apply(swapped));
+    EXPECT_EQ(live.model_swaps(), 1u);
+    const Image b = live.render().image;
+    EXPECT_EQ(b.data, fresh(swapped).data);
+    EXPECT_NE(b.data, a.data);
+    ASSERT_TRUE(live.apply(o));
+    EXPECT_EQ(live.render().image.data, a.data);
+    EXPECT_EQ(ctx.validation_message_count(), 0);
+}

@@ -42,24 +42,24 @@ bool is_png(const fs::path& p) {
            fs::file_size(p) > 1000;
 }
 
+// The tiny sweep's command: `nodes` are the node budgets.
+std::vector<std::string> tiny_args(const fs::path& out, const std::string& nodes) {
+    // Frames timed at another size than the images: their own renderers.
+    return {"study",    "default", "--out",      out.string(), "--device",      "cpu", "--backend",
+            "cpu",      "--steps", "20",         "--batch",    "256",           "--nodes", nodes,
+            "--hash-log2", "12",   "--lods",     "2",          "--threads",     "2",   "--cameras",
+            "2",        "--width", "64",         "--height",   "64",            "--spp",   "2",
+            "--ref-spp", "8",      "--repeat",   "1",          "--time-width",  "32",  "--time-height",
+            "32",       "--save-images"};
+}
+
 // The sweep (about a minute on lavapipe).
 const Study& tiny_study() {
     static const Study s = [] {
         Study st;
         st.dir = nbvh::test::temp_dir("study_tiny") / "out";
         setenv("NBVH_VALIDATION", "1", 1); // the child runs with the validation layer; any message fails
-        // Frames timed at another size than the images: their own renderers.
-        st.run = run_nbvh({"study",        "default", "--out",         st.dir.string(),
-                           "--device",     "cpu",     "--backend",     "cpu",
-                           "--steps",      "20",      "--batch",       "256",
-                           "--nodes",      "31,63",   "--hash-log2",   "12",
-                           "--lods",       "2",       "--threads",     "2",
-                           "--cameras",    "2",       "--width",       "64",
-                           "--height",     "64",      "--spp",         "2",
-                           "--ref-spp",    "8",       "--repeat",      "1",
-                           "--time-width", "32",      "--time-height", "32",
-                           "--save-images"},
-                          500.0);
+        st.run = run_nbvh(tiny_args(st.dir, "31,63"), 500.0);
         unsetenv("NBVH_VALIDATION");
         return st;
     }();
@@ -219,6 +219,38 @@ TEST(Study, BudgetStopsBetweenConfigurations) {
     EXPECT_EQ(j["configs_planned"].get<int>(), 2);
     EXPECT_NE(j["stop_reason"].get<std::string>().find("budget"), std::string::npos);
     EXPECT_EQ(j["configs"].size(), 1u);
+}
+
+// The sweep keeps its hybrid renderers and swaps each configuration's model in (apply()): the second
+// configuration's rows are those of a study that trains only it, with fresh renderers (CPU training is
+// bit-reproducible; same seed). Frame times aside, every figure of those rows is equal.
+TEST(Study, ASweepsLaterConfigurationRendersAsAFreshStudy) {
+    const Study& s = tiny_study();
+    ASSERT_EQ(s.run.exit_code, 0) << s.run.describe();
+    const fs::path alone = nbvh::test::temp_dir("study_alone") / "out";
+    const auto r = run_nbvh(tiny_args(alone, "63"), 500.0);
+    ASSERT_EQ(r.exit_code, 0) << r.describe();
+    auto rows_of = [](const fs::path& dir, int config) {
+        std::ifstream f(dir / "study.json");
+        const nlohmann::json j = nlohmann::json::parse(f);
+        std::vector<nlohmann::json> out;
+        for (const auto& row : j["rows"])
+            if (row["config"].get<int>() == config && row["variant"] != "classical") out.push_back(row);
+        return out;
+    };
+    const std::vector<nlohmann::json> swept = rows_of(s.dir, 1), fresh = rows_of(alone, 0);
+    ASSERT_EQ(swept.size(), fresh.size());
+    ASSERT_FALSE(swept.empty());
+    for (size_t i = 0; i < swept.size(); ++i) {
+        for (const char* k : {"variant", "camera", "lod", "nodes", "memory_bytes", "flip", "flip_same_seed",
+                              "queries_per_ray", "triangles"})
+            EXPECT_EQ(swept[i].value(k, nlohmann::json()), fresh[i].value(k, nlohmann::json()))
+                << k << "\n" << swept[i].dump() << "\n" << fresh[i].dump();
+    }
+    // Control: the first configuration (another model) renders other images.
+    const std::vector<nlohmann::json> first = rows_of(s.dir, 0);
+    ASSERT_FALSE(first.empty());
+    EXPECT_NE(first[0]["flip_same_seed"], swept[0]["flip_same_seed"]);
 }
 
 TEST(Study, BadOptionsFailBeforeAnyWork) {
