@@ -1,7 +1,8 @@
 // One configuration of a study: train a model in-process, decimate the neural meshes to its bytes, and
 // from every camera render each variant (every LoD, the LoD switch, the raised leaf budget) and the
 // decimated meshes: frame time, image, FLIP beside the noise floor, memory, the equal-time baseline.
-// Renderers are built once per model for all cameras and switched between rows with apply().
+// The hybrid renderers serve the whole sweep (the model swapped in by apply()); the decimated scene's
+// are built per configuration, for all cameras.
 #include "app/study/study_run.h"
 
 #include <future>

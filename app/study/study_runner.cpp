@@ -1,8 +1,8 @@
 // The order of work: the classical side of every camera first (converged reference, the noise floor at
 // the compared spp, the classical frame time), then per configuration: train, decimate to its bytes,
 // and per camera every variant of the model (frame time, image, FLIP), the decimated meshes, and the
-// classical renders at equal time (cached per spp). Renderers are built once per camera and model and
-// switched between variants with WavefrontRenderer::apply (uploads, no new pipelines).
+// classical renders at equal time (cached per spp). The hybrid renderers are built once for the sweep and
+// switched between models and rows with WavefrontRenderer::apply (uploads, no new pipelines).
 #include "app/study/study_runner.h"
 #include "app/study/study_run.h"
 
