@@ -28,7 +28,7 @@ struct TrainSettings {
     int nodes = 255;             // target N-BVH nodes
     int batch = 1024;            // rays per step
     int hash_log2 = 14;
-    int lods = 1;
+    int lods = 3;                // as nbvh train: the view's secondary rays take the coarsest
     int threads = 1;             // CPU backend (the renderer shares the cores on lavapipe)
     int snapshot_every = 25;     // steps between models swapped into the view
     std::string backend = "auto"; // auto | cpu | cuda
