@@ -22,7 +22,6 @@
 #include "app/output_path.h"
 #include "app/render_args.h"
 #include "app/render_measure.h"
-#include "app/scene_arg.h"
 #include "engine/bvh/scene_accel.h"
 #include "engine/core/error.h"
 #include "engine/core/flip.h"
@@ -70,11 +69,11 @@ void run_bench(const BenchArgs& a) {
     render::RenderOptions options = a.options;
     options.neural.path = render::parse_neural_path(a.neural_path);
     if (a.repeat == 0) throw Error("--repeat must be at least 1");
-    const NeuralModel model = load_model(a.model);
-    const Scene scene = load_scene_for_model(a.scene, {}, &model, a.model);
-    Environment env = choose_environment(scene, a.env);
-    if (a.env_rotation) env.rotation = *a.env_rotation * 3.14159265358979f / 180.0f;
-    const Camera camera = choose_camera(scene, a.camera, options);
+    const ModelScene ms = load_model_scene(a.scene, a.model, a.env, a.env_rotation, a.camera, options);
+    const NeuralModel& model = ms.model;
+    const Scene& scene = ms.scene;
+    const Environment& env = ms.env;
+    const Camera& camera = ms.camera;
     vk::Context ctx(copt);
     const SceneAccel accel = build_scene_accel(scene);
 

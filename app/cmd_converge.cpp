@@ -27,7 +27,6 @@
 #include "app/commands.h"
 #include "app/output_path.h"
 #include "app/render_args.h"
-#include "app/scene_arg.h"
 #include "app/study/study_options.h"
 #include "engine/bvh/scene_accel.h"
 #include "engine/core/error.h"
@@ -101,22 +100,21 @@ void run_converge(const ConvergeArgs& a) {
     base.neural.path = render::parse_neural_path(a.neural_path);
     base.neural.lod = a.lod;
     base.neural.secondary_lod = parse_secondary_lod(a.secondary_lod);
-    const NeuralModel model = load_model(a.model);
+    const ModelScene ms = load_model_scene(a.scene, a.model, a.env, a.env_rotation, a.camera, base);
+    const NeuralModel& model = ms.model;
+    const Scene& scene = ms.scene;
+    const Environment& env = ms.env;
+    const Camera& camera = ms.camera;
     if (a.lod >= std::max(1u, model.lod_count))
         throw Error(strfmt("--lod %u: the model has %u level(s) of detail", a.lod, std::max(1u, model.lod_count)));
-    const Scene scene = load_scene_for_model(a.scene, {}, &model, a.model);
-    Environment env = choose_environment(scene, a.env);
-    if (a.env_rotation) env.rotation = *a.env_rotation * 3.14159265358979f / 180.0f;
-    const Camera camera = choose_camera(scene, a.camera, base);
-    vk::Context ctx(copt);
-    const SceneAccel accel = build_scene_accel(scene);
-
     render::RenderOptions classical = base;
     classical.neural.classical = true;
     render::validate(classical.neural, scene);
     render::RenderOptions hybrid = base;
     hybrid.neural.model = &model;
     render::validate(hybrid.neural, scene);
+    vk::Context ctx(copt);
+    const SceneAccel accel = build_scene_accel(scene);
 
     // The reference: the true scene at ref_spp with its own seed.
     render::RenderOptions ref_opt = classical;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "app/scene_arg.h"
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/scene/camera.h"
@@ -52,6 +53,18 @@ Camera choose_camera(const Scene& scene, const std::string& camera_arg, const re
     const float aspect = float(o.width) / float(std::max(1u, o.height));
     if (!camera_arg.empty()) return parse_camera(camera_arg);
     return scene.has_camera ? scene.camera : auto_frame(scene, aspect);
+}
+
+ModelScene load_model_scene(const std::string& scene_arg, const std::string& model_path, const std::string& env_path,
+                            std::optional<float> env_rotation_deg, const std::string& camera_arg,
+                            const render::RenderOptions& o) {
+    ModelScene m;
+    m.model = load_model(model_path);
+    m.scene = load_scene_for_model(scene_arg, {}, &m.model, model_path);
+    m.env = choose_environment(m.scene, env_path);
+    if (env_rotation_deg) m.env.rotation = *env_rotation_deg * 3.14159265358979f / 180.0f;
+    m.camera = choose_camera(m.scene, camera_arg, o);
+    return m;
 }
 
 std::optional<float> parse_exposure(const std::string& text) {

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "engine/neural/model_file.h"
 #include "engine/render/wavefront.h"
 #include "engine/scene/scene.h"
 #include "trainer/trainer.h"
@@ -27,6 +28,20 @@ inline constexpr const char* ENV_NONE = "none";
 // The view: `camera_arg` (--camera ex,ey,ez,tx,ty,tz,fov), else the scene's, else auto-framed for the
 // image aspect of `o`.
 Camera choose_camera(const Scene& scene, const std::string& camera_arg, const render::RenderOptions& o);
+
+// What the subcommands that compare a model with its triangles (nbvh bench, nbvh converge) render: the
+// model, the scene bound to it (its asset table decides which instances are neural; scene_arg.h), the
+// environment (choose_environment, turned by `env_rotation_deg`) and the camera (choose_camera for `o`).
+// Keep it where it is made: render options point at `model`.
+struct ModelScene {
+    NeuralModel model;
+    Scene scene;
+    Environment env;
+    Camera camera;
+};
+ModelScene load_model_scene(const std::string& scene_arg, const std::string& model_path, const std::string& env_path,
+                            std::optional<float> env_rotation_deg, const std::string& camera_arg,
+                            const render::RenderOptions& o);
 
 // --exposure: "auto" (nullopt) or a number of stops in [-24, 24]; throws nbvh::Error otherwise.
 std::optional<float> parse_exposure(const std::string& text);

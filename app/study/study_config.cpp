@@ -61,8 +61,9 @@ void StudyRun::run_config(size_t index, const Config& c) {
             progress_.partial(double(p.step) / double(std::max(1u, p.steps)));
         });
     }();
-    // The renderers still point at the last configuration's model until their first apply() below: it
-    // stays alive (previous_model_), so the new one has another address and apply() swaps it in.
+    // The renderers point at the last configuration's model until their first apply() below swaps the
+    // new one in (apply() compares model addresses): the old one stays alive (previous_model_) so that
+    // pointer is never dangling, and the new one, allocated while it lives, has another address.
     previous_model_ = std::move(model_);
     model_ = std::make_unique<NeuralModel>(make_neural_model(*asset_, tr, opt, o_.scene, ts_.source_hash));
     const NeuralModel& model = *model_;
@@ -94,8 +95,9 @@ void StudyRun::run_config(size_t index, const Config& c) {
     // The scene as the models see it (their asset table decides which instances are neural): every
     // configuration learns the same assets, so it is bound once; apply() checks each model against it.
     if (!hybrid_scene_) {
-        hybrid_scene_.emplace(ts_.scene);
-        bind_model_to_scene(*hybrid_scene_, model, "the study's model");
+        Scene bound = ts_.scene;
+        bind_model_to_scene(bound, model, "the study's model");
+        hybrid_scene_.emplace(std::move(bound));
     }
     const uint32_t lods = std::max(1u, model.lod_count);
     const std::vector<Variant> variants = variants_of(index, lods);

@@ -37,6 +37,7 @@ FlipResult flip_ldr(const Image& reference, const Image& test, float ppd = flip_
 // two (the study and `nbvh converge` compare each reference with every row's image). Copies share the
 // prepared planes; the reference image itself is not kept.
 struct FlipPrepared;
+struct FlipKernels;
 class FlipReference {
   public:
     explicit FlipReference(const Image& reference, float ppd = flip_ppd());
@@ -46,7 +47,7 @@ class FlipReference {
 
   private:
     int width_ = 0, height_ = 0, channels_ = 0;
-    std::shared_ptr<const struct FlipKernels> kernels_;
+    std::shared_ptr<const FlipKernels> kernels_;
     std::shared_ptr<const FlipPrepared> prepared_;
 };
 

@@ -22,22 +22,7 @@ std::vector<std::string> tiny_bench(const fs::path& model, const fs::path& json)
             "--spp", "1", "--repeat", "1", "--json", json.string()};
 }
 
-// A tiny 2-LoD model of the default scene (a few seconds on the CPU backend), trained once per test
-// process; the folder is named after the test (ctest runs the tests as parallel processes and temp_dir
-// empties the folder it returns).
-const fs::path& tiny_model() {
-    static const fs::path model = [] {
-        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-        const fs::path dir = nbvh::test::temp_dir("bench_model_" + test);
-        const fs::path m = dir / "tiny.nbvh";
-        const auto r = run_nbvh({"train", "default", "--backend", "cpu", "--steps", "20", "--batch", "256", "--nodes",
-                                 "63", "--hash-log2", "12", "--lods", "2", "--threads", "2", "--out", m.string()},
-                                120.0);
-        EXPECT_EQ(r.exit_code, 0) << r.describe();
-        return m;
-    }();
-    return model;
-}
+const fs::path& tiny_model() { return nbvh::test::tiny_default_model("bench_model"); }
 
 TEST(Bench, TinyModelOnLavapipe) {
     const fs::path json = nbvh::test::temp_dir("bench_run") / "out.json";

@@ -11,22 +11,7 @@ namespace fs = std::filesystem;
 using nbvh::test::check_clean_error;
 using nbvh::test::run_nbvh;
 
-// A tiny 2-LoD model of the default scene's rope knot (about a second on the CPU backend), trained once
-// per test process. ctest runs each test in its own process, in parallel: the folder is named after the
-// test, since temp_dir empties it (one shared folder had one test's model deleted under another).
-const fs::path& tiny_model() {
-    static const fs::path model = [] {
-        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-        const fs::path m = nbvh::test::temp_dir("cli_explain_model_" + test) / "tiny.nbvh";
-        const auto r =
-            run_nbvh({"train", "default", "--backend", "cpu", "--steps", "20", "--batch", "256", "--nodes",
-                      "63", "--hash-log2", "12", "--lods", "2", "--threads", "2", "--out", m.string()},
-                     120.0);
-        EXPECT_EQ(r.exit_code, 0) << r.describe();
-        return m;
-    }();
-    return model;
-}
+const fs::path& tiny_model() { return nbvh::test::tiny_default_model("cli_explain_model"); }
 
 std::vector<std::string> explain(std::vector<std::string> extra) {
     std::vector<std::string> a = {"render", "default", "--device", "cpu", "--explain"};

@@ -11,6 +11,8 @@
 #include <sstream>
 #include <thread>
 
+#include <gtest/gtest.h>
+
 #include "tests/support/test_support.h"
 
 namespace nbvh::test {
@@ -137,6 +139,19 @@ std::string check_clean_error(const RunResult& r, const std::vector<std::string>
     for (const std::string& w : must_mention)
         if (lines.back().find(w) == std::string::npos) return "error line does not mention '" + w + "'";
     return "";
+}
+
+const fs::path& tiny_default_model(const std::string& prefix) {
+    static const fs::path model = [&] {
+        const fs::path m = temp_dir(prefix + "_" + std::to_string(::getpid())) / "tiny.nbvh";
+        const RunResult r = run_nbvh({"train", "default", "--backend", "cpu", "--steps", "20", "--batch", "256",
+                                      "--nodes", "63", "--hash-log2", "12", "--lods", "2", "--threads", "2", "--out",
+                                      m.string()},
+                                     120.0);
+        EXPECT_EQ(r.exit_code, 0) << r.describe();
+        return m;
+    }();
+    return model;
 }
 
 } // namespace nbvh::test

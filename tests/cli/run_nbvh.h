@@ -34,6 +34,13 @@ RunResult run_command(const std::filesystem::path& exe, const std::vector<std::s
 std::string check_clean_error(const RunResult& r, const std::vector<std::string>& must_mention = {},
                               bool strict = true);
 
+// A tiny 2-LoD model of the default scene's rope knot, trained by `nbvh train` on the CPU backend (about a
+// second: 20 steps of 256 rays, 63 nodes, hash 2^12; a poor model, so hybrid and classical images differ),
+// once per test process (the first call's `prefix` names its folder, with the process id): ctest runs each test as its own process, in
+// parallel, and temp_dir empties the folder it returns (a shared folder once lost its model to
+// a sibling test). A failed training fails the calling test.
+const std::filesystem::path& tiny_default_model(const std::string& prefix);
+
 // Lines of a text (without the trailing empty line).
 std::vector<std::string> split_lines(const std::string& text);
 

@@ -19,21 +19,7 @@ namespace fs = std::filesystem;
 using nbvh::test::check_clean_error;
 using nbvh::test::run_nbvh;
 
-// A tiny 2-LoD model, trained once per test process (the folder is named after the test: ctest runs
-// tests in parallel processes and temp_dir empties its folder).
-const fs::path& tiny_model() {
-    static const fs::path model = [] {
-        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-        const fs::path m = nbvh::test::temp_dir("converge_model_" + test) / "tiny.nbvh";
-        const auto r =
-            run_nbvh({"train", "default", "--backend", "cpu", "--steps", "20", "--batch", "256", "--nodes",
-                      "63", "--hash-log2", "12", "--lods", "2", "--threads", "2", "--out", m.string()},
-                     120.0);
-        EXPECT_EQ(r.exit_code, 0) << r.describe();
-        return m;
-    }();
-    return model;
-}
+const fs::path& tiny_model() { return nbvh::test::tiny_default_model("converge_model"); }
 
 std::vector<std::string> converge(const fs::path& dir, const std::string& from, const std::string& spp) {
     return {"converge", "default",   "--model", tiny_model().string(), "--device", "cpu",

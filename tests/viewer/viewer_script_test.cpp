@@ -38,22 +38,7 @@ fs::path find_xvfb_run() {
         if (find_xvfb_run().empty()) GTEST_SKIP() << "xvfb-run not installed (Debian: xvfb)";     \
     } while (0)
 
-// A tiny 2-LoD model of the default scene's rope knot (about a second on the CPU backend): a poor model,
-// so hybrid and classical images differ visibly.
-const fs::path& tiny_model() {
-    static const fs::path model = [] {
-        // One folder per process: ctest runs this file's tests as parallel processes, and temp_dir() empties
-        // the folder it returns (a shared one lost its model to a sibling test in CI).
-        const fs::path m = test::temp_dir("viewer_script_model_" + std::to_string(::getpid())) / "tiny.nbvh";
-        const RunResult r =
-            run_nbvh({"train", "default", "--backend", "cpu", "--steps", "20", "--batch", "256", "--nodes", "63",
-                      "--hash-log2", "12", "--lods", "2", "--threads", "2", "--out", m.string()},
-                     120.0);
-        EXPECT_EQ(r.exit_code, 0) << r.describe();
-        return m;
-    }();
-    return model;
-}
+const fs::path& tiny_model() { return nbvh::test::tiny_default_model("viewer_script_model"); }
 
 // Another model of the same scene and assets (more steps: other weights and cut), for model swaps.
 const fs::path& tiny_model_b() {
