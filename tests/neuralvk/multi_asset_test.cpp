@@ -187,6 +187,29 @@ std::map<std::string, float> flip_per_node(const Scene& scene, const Image& ref,
     return out;
 }
 
+// The live-update tests' setting: the test scene bound to the trained model, a lavapipe context with
+// validation, its BVHs, small scalar-path options of the model, and a fresh renderer's image for options.
+struct LiveSetup {
+    Scene scene;
+    vk::Context ctx{lavapipe()};
+    SceneAccel accel;
+    RenderOptions options;
+    LiveSetup(const NeuralModel& model, uint32_t size, uint32_t seed) : scene(make_scene()) {
+        bind_model_to_scene(scene, model, "m.nbvh");
+        accel = build_scene_accel(scene);
+        options.width = options.height = size;
+        options.spp = 2;
+        options.max_depth = 3;
+        options.seed = seed;
+        options.neural.path = NeuralPath::scalar;
+        options.neural.model = &model;
+    }
+    Image fresh(const RenderOptions& opt) const {
+        WavefrontRenderer r(ctx, scene, accel, default_sky(), scene.camera, opt);
+        return r.render().image;
+    }
+};
+
 } // namespace
 
 TEST(MultiAsset, TrainsEveryAssetInOneModel) {
@@ -274,21 +297,12 @@ TEST(MultiAsset, AModelForAnotherSceneIsRefusedNamingTheAsset) {
 // renders (same seed); size changes are refused (a rebuild).
 TEST(MultiAsset, SettingsApplyWithoutRebuildMatchFreshRenderers) {
     const Trained& t = trained();
-    Scene scene = make_scene();
-    bind_model_to_scene(scene, t.model, "m.nbvh");
-    vk::Context ctx(lavapipe());
-    const SceneAccel accel = build_scene_accel(scene);
-    RenderOptions o;
-    o.width = o.height = 48;
-    o.spp = 2;
-    o.max_depth = 3;
-    o.seed = 9;
-    o.neural.path = NeuralPath::scalar;
-    o.neural.model = &t.model;
-    auto fresh = [&](const RenderOptions& opt) {
-        WavefrontRenderer r(ctx, scene, accel, default_sky(), scene.camera, opt);
-        return r.render().image;
-    };
+    const LiveSetup live_setup(t.model, 48, 9);
+    const Scene& scene = live_setup.scene;
+    const vk::Context& ctx = live_setup.ctx;
+    const SceneAccel& accel = live_setup.accel;
+    RenderOptions o = live_setup.options;
+    auto fresh = [&](const RenderOptions& opt) { return live_setup.fresh(opt); };
     RenderOptions classical = o;
     classical.neural.classical = true;
     RenderOptions deeper = o;
@@ -324,30 +338,21 @@ TEST(MultiAsset, SettingsApplyWithoutRebuildMatchFreshRenderers) {
 // answer the scene is an error that changes nothing.
 TEST(MultiAsset, ModelSwapMatchesAFreshRenderer) {
     const Trained& t = trained();
-    Scene scene = make_scene();
-    bind_model_to_scene(scene, t.model, "m.nbvh");
-    vk::Context ctx(lavapipe());
-    const SceneAccel accel = build_scene_accel(scene);
+    const LiveSetup live_setup(t.model, 48, 9);
+    const Scene& scene = live_setup.scene;
+    const vk::Context& ctx = live_setup.ctx;
+    const SceneAccel& accel = live_setup.accel;
     // Same assets, other numbers: the grid permuted and every asset's atlas offset moved.
     NeuralModel other = t.model;
     for (size_t i = 0; i < other.grid.size(); ++i) other.grid[i] = t.model.grid[(i * 7919 + 13) % t.model.grid.size()];
     for (ModelAsset& a : other.assets) a.offset += glm::vec3(0.02f, -0.01f, 0.015f) * a.scale;
     NeuralModel stranger = t.model; // an asset the scene does not have
     stranger.assets[0].name += "_renamed";
-    RenderOptions o;
-    o.width = o.height = 48;
-    o.spp = 2;
-    o.max_depth = 3;
-    o.seed = 9;
-    o.neural.path = NeuralPath::scalar;
-    o.neural.model = &t.model;
+    const RenderOptions o = live_setup.options;
     RenderOptions swapped = o;
     swapped.neural.model = &other;
     swapped.neural.lod = 0;
-    auto fresh = [&](const RenderOptions& opt) {
-        WavefrontRenderer r(ctx, scene, accel, default_sky(), scene.camera, opt);
-        return r.render().image;
-    };
+    auto fresh = [&](const RenderOptions& opt) { return live_setup.fresh(opt); };
     WavefrontRenderer live(ctx, scene, accel, default_sky(), scene.camera, o);
     const Image a = live.render().image;
     ASSERT_TRUE(live.apply(swapped));
@@ -384,24 +389,15 @@ TEST(MultiAsset, ModelOfAnotherShapeSwapsLikeAFreshRenderer) {
     }();
     ASSERT_NE(other.lod_count, t.model.lod_count);
     ASSERT_NE(other.grid.size(), t.model.grid.size());
-    Scene scene = make_scene();
-    bind_model_to_scene(scene, t.model, "m.nbvh");
-    vk::Context ctx(lavapipe());
-    const SceneAccel accel = build_scene_accel(scene);
-    RenderOptions o;
-    o.width = o.height = 40;
-    o.spp = 2;
-    o.max_depth = 3;
-    o.seed = 5;
-    o.neural.path = NeuralPath::scalar;
-    o.neural.model = &t.model;
+    const LiveSetup live_setup(t.model, 40, 5);
+    const Scene& scene = live_setup.scene;
+    const vk::Context& ctx = live_setup.ctx;
+    const SceneAccel& accel = live_setup.accel;
+    RenderOptions o = live_setup.options;
     o.neural.secondary_lod = SECONDARY_LOD_COARSEST;
     RenderOptions swapped = o;
     swapped.neural.model = &other;
-    auto fresh = [&](const RenderOptions& opt) {
-        WavefrontRenderer r(ctx, scene, accel, default_sky(), scene.camera, opt);
-        return r.render().image;
-    };
+    auto fresh = [&](const RenderOptions& opt) { return live_setup.fresh(opt); };
     WavefrontRenderer live(ctx, scene, accel, default_sky(), scene.camera, o);
     const Image a = live.render().image;
     ASSERT_TRUE(live.apply(swapped));
