@@ -195,12 +195,19 @@ TrainResult train_asset(const TrainingAsset& asset, const TrainOptions& options,
     const uint32_t split_end = schedule.last_split_iteration;
     bool splitting_done = false;
 
+    std::vector<double> heuristics; // of cut0's leaves, this step
     for (uint32_t step = 0; step < options.steps; ++step) {
-        // Survival roulette (paper §3.3): keep = max(h / h_max, 0.005).
+        // Survival roulette (paper §3.3): keep = max(h / h_max, 0.005). Each leaf's heuristic is evaluated
+        // once (two divisions and a square root; the host's largest per-step cost at paper-size cuts, which
+        // the GPU waits for between steps).
+        heuristics.resize(cut0_nodes.size());
         double h_max = 0.0;
-        for (uint32_t n : cut0_nodes) h_max = std::max(h_max, stats[n].heuristic());
         for (size_t i = 0; i < cut0_nodes.size(); ++i) {
-            const double h = stats[cut0_nodes[i]].heuristic();
+            heuristics[i] = stats[cut0_nodes[i]].heuristic();
+            h_max = std::max(h_max, heuristics[i]);
+        }
+        for (size_t i = 0; i < cut0_nodes.size(); ++i) {
+            const double h = heuristics[i];
             cuts[0].keep_probability[i] =
                 (h < 0.0 || h_max <= 0.0) ? 1.0f : float(std::clamp(h / h_max, 0.005, 1.0));
         }
