@@ -1,8 +1,8 @@
 // `nbvh converge` end to end on lavapipe (issue 11): a tiny CPU-trained model of the default scene, its
 // hybrid and classical images extended from 2 to 8 spp against a 32-spp reference; the table, JSON and
 // CSV hold one row per doubling with finite FLIPs, the noise taken out in quadrature as documented, and
-// the rows of a progressive film equal those of fresh renders at that spp. Bad arguments are one-line
-// errors before anything renders.
+// the rows of a progressive film equal those of fresh renders at that spp; scripts/bench/plot_convergence.py
+// draws them. Bad arguments are one-line errors before anything renders.
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -90,6 +90,24 @@ TEST(Converge, DoublingsToTheLargestSppWithFloorAndSharedSeed) {
     ASSERT_EQ(j8["rows"].size(), 1u);
     for (const char* k : {"noise_floor", "flip", "flip_same_seed"})
         EXPECT_EQ(j8["rows"][0][k].get<double>(), j["rows"][2][k].get<double>()) << k;
+
+    // scripts/bench/plot_convergence.py: one panel per run, a PNG, and the table naming the device.
+    const fs::path python = "/usr/bin/python3"; // Debian's, with python3-matplotlib (scripts/setup.sh)
+    if (nbvh::test::run_command(python, {"-c", "import matplotlib"}, 60.0).exit_code != 0)
+        GTEST_SKIP() << "python3-matplotlib is not installed (scripts/setup.sh installs it): plot not checked";
+    const fs::path png = dir / "convergence.png";
+    const auto p = nbvh::test::run_command(
+        python, {(nbvh::test::source_dir() / "scripts/bench/plot_convergence.py").string(), (dir / "c.json").string(),
+                 (fresh / "c.json").string(), png.string()},
+        120.0);
+    ASSERT_EQ(p.exit_code, 0) << p.describe();
+    std::ifstream f(png, std::ios::binary);
+    char sig[8] = {};
+    f.read(sig, 8);
+    EXPECT_EQ(std::string(sig, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+    EXPECT_GT(fs::file_size(png), 1000u);
+    EXPECT_NE(p.out.find("| 8 |"), std::string::npos) << p.out;
+    EXPECT_NE(p.out.find("llvmpipe"), std::string::npos) << "the device is named\n" << p.out;
 }
 
 TEST(Converge, BadArgumentsAreOneLineErrors) {
