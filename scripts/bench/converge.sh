@@ -5,7 +5,10 @@
 # (960x540, max depth 8) and camera 0 (the scene's own, the dragon auto-framed, Chess the paper's).
 # Usage (after `source .device/env.sh`): scripts/bench/converge.sh OUT [default] [dragon] [chess]
 # Env: NBVH (binary, default .device/study/bin/nbvh, xz-packed allowed), FROM (128), SPP (8192),
-#      REF_SPP (32768). Writes OUT/SCENE.json, OUT/SCENE.csv and OUT/log.txt (the tables).
+#      REF_SPP (32768), WIDTH x HEIGHT (960 x 540), BACKEND (cuda), DEVICE (gpu), TRAIN_ARGS (extra nbvh
+#      train flags). Writes OUT/SCENE.json, OUT/SCENE.csv and OUT/log.txt (the tables).
+# A dry run on the build machine: BACKEND=cpu DEVICE=cpu WIDTH=32 HEIGHT=18 FROM=1 SPP=2 REF_SPP=4
+#      TRAIN_ARGS="--steps 20 --batch 256 --nodes 63" NBVH=build/app/nbvh scripts/bench/converge.sh OUT default
 # Estimated on the H100 from the study's frame times: ~5 minutes for the three scenes.
 # Plot afterwards, on the build machine: scripts/bench/plot_convergence.py OUT/*.json results/study/convergence.png
 set -euo pipefail
@@ -44,8 +47,11 @@ fi
     [ "$WHICH" = dragon ] && NEURAL=(--neural '*')
     echo "== $WHICH"
     t0=$(date +%s)
-    "$NBVH" train "${SCENE[@]}" "${NEURAL[@]}" --backend cuda --out "$TMP/$WHICH.nbvh" 2>&1 | grep -v "^step " | tail -3
-    "$NBVH" converge "${SCENE[@]}" --model "$TMP/$WHICH.nbvh" "${VIEW[@]}" --device gpu --width 960 --height 540 \
+    # shellcheck disable=SC2086
+    "$NBVH" train "${SCENE[@]}" "${NEURAL[@]}" --backend "${BACKEND:-cuda}" ${TRAIN_ARGS:-} --out "$TMP/$WHICH.nbvh" 2>&1 \
+      | grep -v "^step " | tail -3
+    "$NBVH" converge "${SCENE[@]}" --model "$TMP/$WHICH.nbvh" "${VIEW[@]}" --device "${DEVICE:-gpu}" \
+      --width "${WIDTH:-960}" --height "${HEIGHT:-540}" \
       --max-depth 8 --from "${FROM:-128}" --spp "${SPP:-8192}" --ref-spp "${REF_SPP:-32768}" \
       --json "$OUT/$WHICH.json" --csv "$OUT/$WHICH.csv"
     echo "$WHICH: $(( $(date +%s) - t0 )) s"
