@@ -128,7 +128,8 @@ void run_bench(const BenchArgs& a) {
                         {"wall_ms", s.wall_ms}, {"ratio_to_classical", ratio}, {"neural_queries", s.neural_queries},
                         {"queries_per_ray", s.neural_queries_per_ray()},
                         {"queries_per_second", s.neural_queries_per_second()}, {"query_gpu_ms", s.neural_query_ms},
-                        {"pass_gpu_ms", pass_ms_json(s)}, {"flip", flip}});
+                        {"pass_gpu_ms", pass_ms_json(s)}, {"pass_gpu_ms_by_depth", pass_depth_ms_json(s)},
+                        {"flip", flip}});
     }
     std::printf("\nneural path %s\n", path_name.c_str());
     if (ctx.validation_enabled() && ctx.validation_message_count() > 0)
@@ -143,7 +144,8 @@ void run_bench(const BenchArgs& a) {
                         {"flip_metric", "ldr: ACES tone map + 8-bit sRGB (as nbvh render PNGs), ppd 67.02; hybrid and "
                                         "reference share the seed"},
                         {"classical",
-                         {{"gpu_ms", ref_ms}, {"wall_ms", ref.stats.wall_ms}, {"pass_gpu_ms", pass_ms_json(ref.stats)}}},
+                         {{"gpu_ms", ref_ms}, {"wall_ms", ref.stats.wall_ms}, {"pass_gpu_ms", pass_ms_json(ref.stats)},
+                          {"pass_gpu_ms_by_depth", pass_depth_ms_json(ref.stats)}}},
                         {"lods", rows}};
     write_text_atomically(a.json, j.dump(2) + "\n");
 }

@@ -23,6 +23,7 @@
 #include "app/commands.h"
 #include "app/output_path.h"
 #include "app/render_args.h"
+#include "app/render_measure.h"
 #include "app/scene_arg.h"
 #include "engine/bvh/scene_accel.h"
 #include "engine/core/error.h"
@@ -62,9 +63,8 @@ void write_stats(const std::string& path, const render::RenderStats& s, const st
     j["height"] = s.height;
     j["spp"] = s.spp;
     j["max_depth"] = s.max_depth;
-    nlohmann::json passes = nlohmann::json::object();
-    for (const auto& [name, ms] : s.pass_ms) passes[name] = ms;
-    j["pass_gpu_ms"] = passes;
+    j["pass_gpu_ms"] = pass_ms_json(s);
+    j["pass_gpu_ms_by_depth"] = pass_depth_ms_json(s);
     j["gpu_total_ms"] = s.gpu_ms;
     j["wall_ms"] = s.wall_ms;
     j["rays"] = {{"primary", s.rays_primary}, {"secondary", s.rays_secondary}, {"shadow", s.rays_shadow},

@@ -19,6 +19,12 @@ nlohmann::json pass_ms_json(const render::RenderStats& s) {
     return passes;
 }
 
+nlohmann::json pass_depth_ms_json(const render::RenderStats& s) {
+    nlohmann::json passes = nlohmann::json::object();
+    for (const auto& [name, ms] : s.pass_depth_ms) passes[name] = ms;
+    return passes;
+}
+
 std::string command_line(int argc, const char* const* argv) {
     std::string out;
     for (int i = 0; i < argc; ++i) {

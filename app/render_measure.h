@@ -18,6 +18,8 @@ render::RenderStats median_render_stats(render::WavefrontRenderer& renderer, uin
 
 // Per-pass GPU milliseconds of `s` as a JSON object.
 nlohmann::json pass_ms_json(const render::RenderStats& s);
+// The same per path depth: pass name -> [ms at depth 0, 1, ...] (RenderStats::pass_depth_ms).
+nlohmann::json pass_depth_ms_json(const render::RenderStats& s);
 
 // The command line as one string (arguments with spaces or quotes single-quoted), for result files.
 std::string command_line(int argc, const char* const* argv);

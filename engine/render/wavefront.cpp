@@ -305,7 +305,7 @@ GpuPassConstants WavefrontRenderer::constants(uint32_t queue, uint32_t depth, co
 
 void WavefrontRenderer::record_pass(vk::CommandBuffer& cmd, size_t pass, const GpuPassConstants& pc,
                                     Dispatch dispatch, uint64_t items) {
-    cmd.begin_pass(PASS_SHADERS[pass], timer_.available() ? &timer_ : nullptr);
+    cmd.begin_pass(PASS_SHADERS[pass], timer_.available() ? &timer_ : nullptr, pc.depth);
     cmd.bind(pipelines_[pass], sets_[pass]).push(pc);
     switch (dispatch) {
     case Dispatch::items: cmd.dispatch_items(items, NB_WAVEFRONT_GROUP); break;
@@ -403,17 +403,21 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
     if (neural_) buffers_[NB_BIND_NEURAL_COUNTERS].fill(0u);
 
     std::vector<std::pair<std::string, double>> pass_ms;
+    std::vector<std::vector<double>> depth_ms; // per pass_ms entry, by path depth
     std::map<std::string, size_t> pass_index;
     auto collect = [&] {
         if (!timer_.available()) return;
-        for (const auto& [name, ms] : timer_.results()) {
-            auto it = pass_index.find(name);
+        for (const vk::GpuTimer::SlotResult& r : timer_.slot_results()) {
+            auto it = pass_index.find(r.name);
             if (it == pass_index.end()) {
-                pass_index[name] = pass_ms.size();
-                pass_ms.emplace_back(name, ms);
-            } else {
-                pass_ms[it->second].second += ms;
+                it = pass_index.emplace(r.name, pass_ms.size()).first;
+                pass_ms.emplace_back(r.name, 0.0);
+                depth_ms.emplace_back();
             }
+            pass_ms[it->second].second += r.ms;
+            std::vector<double>& d = depth_ms[it->second];
+            if (d.size() <= r.tag) d.resize(size_t(r.tag) + 1, 0.0);
+            d[r.tag] += r.ms;
         }
     };
     // The GPU's statistics counters are 32-bit and wrap within a long render (a 1080p frame at 4096 spp
@@ -482,6 +486,7 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
     s.spp = first + count_samples;
     s.max_depth = options_.max_depth;
     s.pass_ms = pass_ms;
+    for (size_t i = 0; i < pass_ms.size(); ++i) s.pass_depth_ms.emplace_back(pass_ms[i].first, depth_ms[i]);
     for (const auto& [name, ms] : pass_ms) s.gpu_ms += ms;
     s.rays_primary = totals[0];
     s.rays_secondary = totals[1];

@@ -48,6 +48,9 @@ struct RenderStats {
     std::string device, driver;
     uint32_t width = 0, height = 0, spp = 0, max_depth = 0;
     std::vector<std::pair<std::string, double>> pass_ms; // summed GPU time per pass (timestamps)
+    // The same per path depth (index = bounce: 0 for camera rays and the per-sample passes); each
+    // pass's entries sum to its pass_ms. Tells deep bounces' small dispatches from the first ones.
+    std::vector<std::pair<std::string, std::vector<double>>> pass_depth_ms;
     double gpu_ms = 0.0;           // sum of the passes
     double wall_ms = 0.0;          // host time of render(), submissions included
     uint64_t rays_primary = 0, rays_secondary = 0, rays_shadow = 0;

@@ -241,10 +241,10 @@ CommandBuffer& CommandBuffer::transition(VkImage image, VkImageLayout from, VkIm
     return *this;
 }
 
-CommandBuffer& CommandBuffer::begin_pass(const std::string& name, GpuTimer* timer) {
+CommandBuffer& CommandBuffer::begin_pass(const std::string& name, GpuTimer* timer, uint32_t tag) {
     NBVH_CHECK(recording_);
     ctx_->begin_label(cmd_, name.c_str());
-    uint32_t slot = timer ? timer->begin(cmd_, name) : 0;
+    uint32_t slot = timer ? timer->begin(cmd_, name, tag) : 0;
     open_passes_.push_back({timer, slot});
     return *this;
 }
@@ -304,19 +304,22 @@ GpuTimer& GpuTimer::operator=(GpuTimer&& o) noexcept {
         pool_ = std::exchange(o.pool_, VK_NULL_HANDLE);
         max_passes_ = o.max_passes_;
         names_ = std::move(o.names_);
+        tags_ = std::move(o.tags_);
     }
     return *this;
 }
 
 void GpuTimer::reset(VkCommandBuffer cmd) {
     names_.clear();
+    tags_.clear();
     if (pool_) vkCmdResetQueryPool(cmd, pool_, 0, 2 * max_passes_);
 }
 
-uint32_t GpuTimer::begin(VkCommandBuffer cmd, const std::string& name) {
+uint32_t GpuTimer::begin(VkCommandBuffer cmd, const std::string& name, uint32_t tag) {
     uint32_t slot = uint32_t(names_.size());
     if (!pool_ || slot >= max_passes_) return UINT32_MAX;
     names_.push_back(name);
+    tags_.push_back(tag);
     vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, pool_, 2 * slot);
     return slot;
 }
@@ -326,8 +329,8 @@ void GpuTimer::end(VkCommandBuffer cmd, uint32_t slot) {
     vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, 2 * slot + 1);
 }
 
-std::vector<std::pair<std::string, double>> GpuTimer::results() const {
-    std::vector<std::pair<std::string, double>> out;
+std::vector<GpuTimer::SlotResult> GpuTimer::slot_results() const {
+    std::vector<SlotResult> out;
     if (!pool_ || names_.empty()) return out;
     std::vector<uint64_t> ticks(2 * names_.size());
     NBVH_VK_CHECK(vkGetQueryPoolResults(ctx_->device(), pool_, 0, uint32_t(ticks.size()),
@@ -336,14 +339,22 @@ std::vector<std::pair<std::string, double>> GpuTimer::results() const {
     const uint32_t bits = ctx_->features().timestamp_valid_bits;
     const uint64_t mask = bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << bits) - 1;
     const double ms_per_tick = double(ctx_->features().timestamp_period) * 1e-6;
+    out.reserve(names_.size());
     for (size_t i = 0; i < names_.size(); ++i) {
-        uint64_t dt = (ticks[2 * i + 1] - ticks[2 * i]) & mask; // wrap-around safe
-        double ms = double(dt) * ms_per_tick;
-        auto it = std::find_if(out.begin(), out.end(), [&](const auto& p) { return p.first == names_[i]; });
+        const uint64_t dt = (ticks[2 * i + 1] - ticks[2 * i]) & mask; // wrap-around safe
+        out.push_back({names_[i], tags_[i], double(dt) * ms_per_tick});
+    }
+    return out;
+}
+
+std::vector<std::pair<std::string, double>> GpuTimer::results() const {
+    std::vector<std::pair<std::string, double>> out;
+    for (const SlotResult& r : slot_results()) {
+        auto it = std::find_if(out.begin(), out.end(), [&](const auto& p) { return p.first == r.name; });
         if (it == out.end())
-            out.push_back({names_[i], ms});
+            out.push_back({r.name, r.ms});
         else
-            it->second += ms;
+            it->second += r.ms;
     }
     return out;
 }

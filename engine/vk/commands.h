@@ -111,7 +111,8 @@ public:
 
     // A named region: debug label (RenderDoc/Nsight) and, with a timer, a timestamp pair. Nestable
     // for labels; the timer sums nested regions independently.
-    CommandBuffer& begin_pass(const std::string& name, GpuTimer* timer = nullptr);
+    // `tag`: a number kept with the pass's timestamps (GpuTimer::slot_results), e.g. a path depth.
+    CommandBuffer& begin_pass(const std::string& name, GpuTimer* timer = nullptr, uint32_t tag = 0);
     CommandBuffer& end_pass();
 
     VkCommandBuffer handle() const { return cmd_; }
@@ -144,11 +145,19 @@ public:
 
     bool available() const { return pool_ != VK_NULL_HANDLE; } // false when the queue has no timestamps
     void reset(VkCommandBuffer cmd);
-    // Returns a slot for end(); passes beyond max_passes are silently not timed.
-    uint32_t begin(VkCommandBuffer cmd, const std::string& name);
+    // Returns a slot for end(); passes beyond max_passes are silently not timed. `tag` is kept with the
+    // slot (slot_results).
+    uint32_t begin(VkCommandBuffer cmd, const std::string& name, uint32_t tag = 0);
     void end(VkCommandBuffer cmd, uint32_t slot);
     // (pass name, milliseconds) in order of first appearance. Blocks until the results are ready.
     std::vector<std::pair<std::string, double>> results() const;
+    // Every timed slot in recording order: its pass name, tag and milliseconds. Blocks likewise.
+    struct SlotResult {
+        std::string name;
+        uint32_t tag = 0;
+        double ms = 0.0;
+    };
+    std::vector<SlotResult> slot_results() const;
     double total_ms() const;
 
 private:
@@ -156,6 +165,7 @@ private:
     VkQueryPool pool_ = VK_NULL_HANDLE;
     uint32_t max_passes_ = 0;
     std::vector<std::string> names_; // one per used slot
+    std::vector<uint32_t> tags_;     // one per used slot
 };
 
 } // namespace nbvh::vk

@@ -86,6 +86,7 @@ struct Outcome {
     bool image = false;          // the output image exists
     int64_t non_finite = -1;     // from --stats (-1: no stats file)
     bool dir_clean = true;       // nothing but the image/stats in the output dir (no temp files left)
+    bool depth_times = false;    // --stats has pass_gpu_ms_by_depth for the passes of pass_gpu_ms
 };
 
 Outcome render(const fs::path& scene, const fs::path& dir) {
@@ -98,7 +99,13 @@ Outcome render(const fs::path& scene, const fs::path& dir) {
     if (fs::exists(stats)) {
         try {
             std::ifstream f(stats);
-            o.non_finite = nlohmann::json::parse(f).at("non_finite_pixels").get<int64_t>();
+            const nlohmann::json j = nlohmann::json::parse(f);
+            o.non_finite = j.at("non_finite_pixels").get<int64_t>();
+            const nlohmann::json &passes = j.at("pass_gpu_ms"), &by_depth = j.at("pass_gpu_ms_by_depth");
+            o.depth_times = by_depth.size() == passes.size();
+            for (const auto& [name, ms] : passes.items())
+                o.depth_times = o.depth_times && by_depth.contains(name) && by_depth[name].is_array() &&
+                                !by_depth[name].empty() && by_depth[name].size() <= 2; // --max-depth 2
         } catch (const std::exception&) {
             o.non_finite = -2;
         }
@@ -112,6 +119,7 @@ void expect_rendered(const Outcome& o) {
     EXPECT_EQ(o.run.exit_code, 0) << o.run.describe();
     EXPECT_TRUE(o.image) << "no output image";
     EXPECT_EQ(o.non_finite, 0) << "non_finite_pixels in --stats (-1: no stats file)";
+    EXPECT_TRUE(o.depth_times) << "pass_gpu_ms_by_depth in --stats";
 }
 
 // strict: only "warning: " lines may precede the error (files the loader must reject); otherwise the

@@ -174,3 +174,38 @@ TEST(Render, DefaultScene) {
 
 } // namespace
 } // namespace nbvh::render
+
+namespace nbvh::render {
+namespace {
+
+// Per-depth pass times (RenderStats::pass_depth_ms, `--stats` pass_gpu_ms_by_depth): every timed pass
+// has its entry, in the same order, summing to its pass_ms; depths stay below max_depth; the camera pass
+// runs at depth 0 only and the bounce passes also deeper (the default scene's paths bounce).
+TEST(Render, PassTimesByPathDepthAddUpToThePassTimes) {
+    const Scene s = assets::make_default_scene();
+    const uint32_t max_depth = 4;
+    const Rendered r = render_small(s, s.environment, 2, max_depth);
+    expect_sane(r);
+    const RenderStats& st = r.result.stats;
+    if (st.pass_ms.empty()) GTEST_SKIP() << "no GPU timestamps on this device";
+    ASSERT_EQ(st.pass_depth_ms.size(), st.pass_ms.size());
+    for (size_t i = 0; i < st.pass_ms.size(); ++i) {
+        const auto& [name, ms] = st.pass_ms[i];
+        const auto& [dname, by_depth] = st.pass_depth_ms[i];
+        EXPECT_EQ(dname, name);
+        ASSERT_FALSE(by_depth.empty()) << name;
+        EXPECT_LE(by_depth.size(), size_t(max_depth)) << name;
+        double sum = 0.0;
+        for (double d : by_depth) {
+            EXPECT_GE(d, 0.0) << name;
+            sum += d;
+        }
+        EXPECT_NEAR(sum, ms, 1e-9 * std::max(1.0, ms)) << name;
+        if (name == "passes/camera_rays.comp") EXPECT_EQ(by_depth.size(), 1u);
+        if (name == "passes/traverse.comp" || name == "passes/shade.comp")
+            EXPECT_EQ(by_depth.size(), size_t(max_depth)) << name << ": every bounce traces";
+    }
+}
+
+} // namespace
+} // namespace nbvh::render
