@@ -69,6 +69,7 @@ void write_stats(const std::string& path, const render::RenderStats& s, const st
     j["wall_ms"] = s.wall_ms;
     j["rays"] = {{"primary", s.rays_primary}, {"secondary", s.rays_secondary}, {"shadow", s.rays_shadow},
                  {"total", s.rays_total()}};
+    j["rays_by_depth"] = {{"path", s.rays_by_depth}, {"shadow", s.shadow_rays_by_depth}};
     j["rays_per_second"] = s.rays_per_second();
     j["non_finite_samples"] = s.nonfinite_samples;
     j["non_finite_pixels"] = s.nonfinite_pixels;

@@ -423,8 +423,11 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
     // The GPU's statistics counters are 32-bit and wrap within a long render (a 1080p frame at 4096 spp
     // traces ~1e10 rays): they are read after every submission (each adds far less than 2^32) and the
     // wrapped differences summed in 64 bits.
-    uint64_t totals[7] = {0, 0, 0, 0, 0, 0, 0};
-    uint32_t last[7] = {0, 0, 0, 0, 0, 0, 0};
+    // [0..6]: primary, secondary, shadow rays, non-finite samples, neural queries, rounds, leaf-cap rays;
+    // then path rays and shadow rays per bounce (NB_STAT_DEPTHS each).
+    constexpr size_t N = 7 + 2 * NB_STAT_DEPTHS;
+    uint64_t totals[N] = {};
+    uint32_t last[N] = {};
     // The counters are copied into counter_readback_ at the end of each submission (no extra round trip).
     auto record_counter_copy = [&] {
         cmd_.barrier(vk::Barrier::compute_to_transfer);
@@ -438,7 +441,11 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
         const char* mapped = static_cast<const char*>(counter_readback_.mapped());
         GpuQueueCounters c;
         std::memcpy(&c, mapped, sizeof(c));
-        uint32_t now[7] = {c.rays_primary, c.rays_secondary, c.rays_shadow, c.nonfinite_samples, 0, 0, 0};
+        uint32_t now[N] = {c.rays_primary, c.rays_secondary, c.rays_shadow, c.nonfinite_samples, 0, 0, 0};
+        for (uint32_t d = 0; d < NB_STAT_DEPTHS; ++d) {
+            now[7 + d] = c.rays_by_depth[d];
+            now[7 + NB_STAT_DEPTHS + d] = c.shadow_rays_by_depth[d];
+        }
         if (neural_) {
             GpuNeuralCounters nc;
             std::memcpy(&nc, mapped + sizeof(GpuQueueCounters), sizeof(nc));
@@ -446,7 +453,7 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
             now[5] = nc.rounds;
             now[6] = nc.leaf_cap_rays;
         }
-        for (int k = 0; k < 7; ++k) {
+        for (size_t k = 0; k < N; ++k) {
             totals[k] += uint32_t(now[k] - last[k]);
             last[k] = now[k];
         }
@@ -492,6 +499,9 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
     s.rays_secondary = totals[1];
     s.rays_shadow = totals[2];
     s.nonfinite_samples = totals[3];
+    const uint32_t depths = std::min(options_.max_depth, NB_STAT_DEPTHS);
+    s.rays_by_depth.assign(totals + 7, totals + 7 + depths);
+    s.shadow_rays_by_depth.assign(totals + 7 + NB_STAT_DEPTHS, totals + 7 + NB_STAT_DEPTHS + depths);
     s.texture_path = texture_path_name(texture_plan_.path);
     s.texture_count = texture_plan_.textures;
     s.texture_bytes = texture_plan_.bytes;

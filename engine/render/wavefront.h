@@ -54,6 +54,9 @@ struct RenderStats {
     double gpu_ms = 0.0;           // sum of the passes
     double wall_ms = 0.0;          // host time of render(), submissions included
     uint64_t rays_primary = 0, rays_secondary = 0, rays_shadow = 0;
+    // Path rays and shadow rays per bounce (index = depth, min(max_depth, NB_STAT_DEPTHS) entries, the
+    // last also counting deeper bounces): with pass_depth_ms, the time per ray of each bounce.
+    std::vector<uint64_t> rays_by_depth, shadow_rays_by_depth;
     uint64_t nonfinite_samples = 0; // dropped by accumulate.comp
     uint64_t nonfinite_pixels = 0;  // in the resolved image (counted on the CPU; must be 0)
     // Textures (texture_path.h): the path that ran, its textures and their GPU bytes (buffer: the texel

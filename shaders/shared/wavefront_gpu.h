@@ -78,6 +78,8 @@ struct GpuDispatchArgs {
 };
 NB_STATIC_ASSERT(sizeof(GpuDispatchArgs) == 12, "GpuDispatchArgs layout");
 
+#define NB_STAT_DEPTHS 16u // per-bounce ray statistics kept (GpuQueueCounters)
+
 // One buffer (storage + indirect usage). Byte offsets of the dispatch arguments are fixed below so
 // the host can pass them to vkCmdDispatchIndirect.
 struct GpuQueueCounters {
@@ -92,8 +94,12 @@ struct GpuQueueCounters {
     uint rays_secondary;
     uint rays_shadow;
     uint nonfinite_samples;          // path samples dropped by accumulate because they were NaN/Inf
+    // Path rays and shadow rays per bounce (index = depth; the last bucket also counts deeper ones),
+    // beside the per-depth pass times of RenderStats.
+    uint rays_by_depth[NB_STAT_DEPTHS];
+    uint shadow_rays_by_depth[NB_STAT_DEPTHS];
 };
-NB_STATIC_ASSERT(sizeof(GpuQueueCounters) == 68, "GpuQueueCounters layout");
+NB_STATIC_ASSERT(sizeof(GpuQueueCounters) == 68 + 8 * NB_STAT_DEPTHS, "GpuQueueCounters layout");
 // shadow.comp: the occlusion was decided by passes/neural_shadow.comp (hybrid renders).
 #define NB_SHADOW_MODE_HYBRID 1u
 #define NB_COUNTERS_RAY_DISPATCH_OFFSET 0u

@@ -84,7 +84,15 @@
     F(shadow_dispatch.x) F(shadow_dispatch.y) F(shadow_dispatch.z)                                \
     F(pending_dispatch.x) F(pending_dispatch.y) F(pending_dispatch.z)                             \
     F(ray_count0) F(ray_count1) F(shadow_count) F(pending_count) F(rays_primary)                  \
-    F(rays_secondary) F(rays_shadow) F(nonfinite_samples)
+    F(rays_secondary) F(rays_shadow) F(nonfinite_samples) \
+    F(rays_by_depth[0]) F(rays_by_depth[1]) F(rays_by_depth[2]) F(rays_by_depth[3]) \
+    F(rays_by_depth[4]) F(rays_by_depth[5]) F(rays_by_depth[6]) F(rays_by_depth[7]) \
+    F(rays_by_depth[8]) F(rays_by_depth[9]) F(rays_by_depth[10]) F(rays_by_depth[11]) \
+    F(rays_by_depth[12]) F(rays_by_depth[13]) F(rays_by_depth[14]) F(rays_by_depth[15]) \
+    F(shadow_rays_by_depth[0]) F(shadow_rays_by_depth[1]) F(shadow_rays_by_depth[2]) F(shadow_rays_by_depth[3]) \
+    F(shadow_rays_by_depth[4]) F(shadow_rays_by_depth[5]) F(shadow_rays_by_depth[6]) F(shadow_rays_by_depth[7]) \
+    F(shadow_rays_by_depth[8]) F(shadow_rays_by_depth[9]) F(shadow_rays_by_depth[10]) F(shadow_rays_by_depth[11]) \
+    F(shadow_rays_by_depth[12]) F(shadow_rays_by_depth[13]) F(shadow_rays_by_depth[14]) F(shadow_rays_by_depth[15])
 #define NB_LAYOUT_FIELDS_GpuPassConstants(F)                                                      \
     F(in_queue) F(depth) F(sample_index) F(pixel_offset) F(pixel_count) F(mode) F(wave_samples)
 #define NB_LAYOUT_FIELDS_GpuNeuralQuery(F) F(origin) F(t_entry) F(dir) F(t_exit)

@@ -178,15 +178,38 @@ TEST(Render, DefaultScene) {
 namespace nbvh::render {
 namespace {
 
-// Per-depth pass times (RenderStats::pass_depth_ms, `--stats` pass_gpu_ms_by_depth): every timed pass
-// has its entry, in the same order, summing to its pass_ms; depths stay below max_depth; the camera pass
-// runs at depth 0 only and the bounce passes also deeper (the default scene's paths bounce).
-TEST(Render, PassTimesByPathDepthAddUpToThePassTimes) {
+// Per-depth statistics: rays per bounce (RenderStats::rays_by_depth / shadow_rays_by_depth, `--stats`
+// rays_by_depth) add up to the ray totals, depth 0 being the camera rays; pass times per depth
+// (pass_depth_ms, `--stats` pass_gpu_ms_by_depth): every timed pass has its entry, in the same order,
+// summing to its pass_ms; depths stay below max_depth; the camera pass runs at depth 0 only and the
+// bounce passes also deeper (the default scene's paths bounce).
+TEST(Render, PassTimesAndRaysByPathDepthAddUpToTheTotals) {
     const Scene s = assets::make_default_scene();
     const uint32_t max_depth = 4;
     const Rendered r = render_small(s, s.environment, 2, max_depth);
     expect_sane(r);
     const RenderStats& st = r.result.stats;
+    ASSERT_EQ(st.rays_by_depth.size(), size_t(max_depth));
+    ASSERT_EQ(st.shadow_rays_by_depth.size(), size_t(max_depth));
+    EXPECT_EQ(st.rays_by_depth[0], st.rays_primary);
+    uint64_t path = 0, shadow = 0;
+    for (uint32_t d = 0; d < max_depth; ++d) {
+        path += st.rays_by_depth[d];
+        shadow += st.shadow_rays_by_depth[d];
+        if (d > 0) EXPECT_LE(st.rays_by_depth[d], st.rays_by_depth[d - 1]) << "a bounce continues at most its rays";
+    }
+    EXPECT_EQ(path, st.rays_primary + st.rays_secondary);
+    EXPECT_EQ(shadow, st.rays_shadow);
+    EXPECT_GT(st.rays_by_depth[1], 0u);
+    EXPECT_GT(st.shadow_rays_by_depth[0], 0u);
+    // Deeper than the buckets: the last one counts the rest, the sums still hold.
+    const Rendered deep = render_small(s, s.environment, 1, NB_STAT_DEPTHS + 4, 3, 16, 16);
+    const RenderStats& ds = deep.result.stats;
+    ASSERT_EQ(ds.rays_by_depth.size(), size_t(NB_STAT_DEPTHS));
+    uint64_t deep_path = 0, deep_shadow = 0;
+    for (uint32_t d = 0; d < NB_STAT_DEPTHS; ++d) deep_path += ds.rays_by_depth[d], deep_shadow += ds.shadow_rays_by_depth[d];
+    EXPECT_EQ(deep_path, ds.rays_primary + ds.rays_secondary);
+    EXPECT_EQ(deep_shadow, ds.rays_shadow);
     if (st.pass_ms.empty()) GTEST_SKIP() << "no GPU timestamps on this device";
     ASSERT_EQ(st.pass_depth_ms.size(), st.pass_ms.size());
     for (size_t i = 0; i < st.pass_ms.size(); ++i) {
