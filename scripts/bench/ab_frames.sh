@@ -61,6 +61,10 @@ for name in ["default_classical", "default_hybrid", "dragon_classical", "dragon_
         spp = best["spp"]
         r[b] = {"ms_per_spp": best["gpu_total_ms"] / spp, "all_ms_per_spp": [j["gpu_total_ms"] / spp for j in runs],
                 "passes_ms_per_spp": {k.split("/")[-1].replace(".comp", ""): v / spp for k, v in best["pass_gpu_ms"].items()},
+                # per bounce, where the binary writes them (since d9e67b5 / aecfd79)
+                "passes_ms_per_spp_by_depth": {k.split("/")[-1].replace(".comp", ""): [x / spp for x in v]
+                                               for k, v in best.get("pass_gpu_ms_by_depth", {}).items()},
+                "rays_per_spp_by_depth": {k: [x / spp for x in v] for k, v in best.get("rays_by_depth", {}).items()},
                 "rays_per_second": best["rays_per_second"], "neural": best.get("neural")}
     m = re.search(r"[-+]?\d*\.\d+(?:[eE][-+]?\d+)?|\d+", open(os.path.join(t, f"{name}_flip.txt")).read())
     r["flip_ldr_old_vs_new"] = float(m.group()) if m else None
