@@ -197,9 +197,9 @@ TrainResult train_asset(const TrainingAsset& asset, const TrainOptions& options,
 
     std::vector<double> heuristics; // of cut0's leaves, this step
     for (uint32_t step = 0; step < options.steps; ++step) {
-        // Survival roulette (paper §3.3): keep = max(h / h_max, 0.005). Each leaf's heuristic is evaluated
-        // once (two divisions and a square root; the host's largest per-step cost at paper-size cuts, which
-        // the GPU waits for between steps).
+        // Survival roulette (paper §3.3): keep = max(h / h_max, 0.005). Each leaf's heuristic (two
+        // divisions and a square root) is evaluated once per step: host work between the CUDA backend's
+        // steps, 25k leaves at paper-size cuts.
         heuristics.resize(cut0_nodes.size());
         double h_max = 0.0;
         for (size_t i = 0; i < cut0_nodes.size(); ++i) {

@@ -239,12 +239,19 @@ float float_mean(const std::vector<float>& v) {
     return v.empty() ? 0.0f : sum / float(v.size());
 }
 
+// A test image against a w x h reference.
+void check_test(int w, int h, const Image& test) {
+    if (test.empty()) throw Error("FLIP: empty image");
+    if (w != test.width || h != test.height)
+        throw Error(strfmt("FLIP: reference is %dx%d but test is %dx%d (sizes must match)", w, h, test.width,
+                           test.height));
+    if (test.channels < 3) throw Error("FLIP: images need 3 or 4 channels (RGB/RGBA)");
+}
+
 void check_pair(const Image& ref, const Image& test) {
-    if (ref.empty() || test.empty()) throw Error("FLIP: empty image");
-    if (ref.width != test.width || ref.height != test.height)
-        throw Error(strfmt("FLIP: reference is %dx%d but test is %dx%d (sizes must match)", ref.width, ref.height,
-                           test.width, test.height));
-    if (ref.channels < 3 || test.channels < 3) throw Error("FLIP: images need 3 or 4 channels (RGB/RGBA)");
+    if (ref.empty()) throw Error("FLIP: empty image");
+    check_test(ref.width, ref.height, test);
+    if (ref.channels < 3) throw Error("FLIP: images need 3 or 4 channels (RGB/RGBA)");
 }
 
 } // namespace
@@ -306,16 +313,8 @@ FlipKernels flip_kernels(float ppd) {
 }
 
 FlipResult flip_ldr(const Image& reference, const Image& test, float ppd) {
-    check_pair(reference, test);
-    if (!(ppd > 0.0f) || !std::isfinite(ppd)) throw Error(strfmt("FLIP: invalid pixels per degree %g", double(ppd)));
-    const FlipKernels k = flip_kernels(ppd);
-    FlipResult res;
-    res.width = reference.width;
-    res.height = reference.height;
-    res.error = ldr_map(reference.data.data(), reference.channels, test.data.data(), test.channels, res.width,
-                        res.height, k);
-    res.mean = float_mean(res.error);
-    return res;
+    check_pair(reference, test); // before filtering the reference
+    return FlipReference(reference, ppd).compare(test);
 }
 
 FlipReference::FlipReference(const Image& reference, float ppd) {
@@ -324,19 +323,13 @@ FlipReference::FlipReference(const Image& reference, float ppd) {
     if (!(ppd > 0.0f) || !std::isfinite(ppd)) throw Error(strfmt("FLIP: invalid pixels per degree %g", double(ppd)));
     width_ = reference.width;
     height_ = reference.height;
-    channels_ = reference.channels;
     kernels_ = std::make_shared<const FlipKernels>(flip_kernels(ppd));
     prepared_ = std::make_shared<const FlipPrepared>(
         prepare(reference.data.data(), reference.channels, width_, height_, *kernels_));
 }
 
 FlipResult FlipReference::compare(const Image& test) const {
-    Image shape; // check_pair's messages, without copying the reference
-    shape.width = width_;
-    shape.height = height_;
-    shape.channels = channels_;
-    shape.data.resize(1);
-    check_pair(shape, test);
+    check_test(width_, height_, test);
     FlipResult res;
     res.width = width_;
     res.height = height_;

@@ -33,9 +33,9 @@ struct FlipResult {
 FlipResult flip_ldr(const Image& reference, const Image& test, float ppd = flip_ppd());
 
 // One reference prepared once (colour transforms, CSF and feature filters) for LDR-FLIP against many test
-// images: compare(test) equals flip_ldr(reference, test, ppd) bit for bit and filters one image instead of
-// two (the study and `nbvh converge` compare each reference with every row's image). Copies share the
-// prepared planes; the reference image itself is not kept.
+// images: flip_ldr(reference, test, ppd) is FlipReference(reference, ppd).compare(test); a kept one
+// filters one image per comparison instead of two (the study and `nbvh converge` compare each reference
+// with every row's image). Copies share the prepared planes; the reference image itself is not kept.
 struct FlipPrepared;
 struct FlipKernels;
 class FlipReference {
@@ -46,7 +46,7 @@ class FlipReference {
     int height() const { return height_; }
 
   private:
-    int width_ = 0, height_ = 0, channels_ = 0;
+    int width_ = 0, height_ = 0;
     std::shared_ptr<const FlipKernels> kernels_;
     std::shared_ptr<const FlipPrepared> prepared_;
 };

@@ -243,14 +243,15 @@ TEST(Flip, HeatmapEndsAreMagma) {
     EXPECT_GT(px[3] + px[4] + px[5], 3 * 230 - 60); // pale yellow
 }
 
-// A prepared reference gives flip_ldr's map and mean bit for bit: several test images against one
-// reference, a multi-threaded size and a single-band one (under 64 rows), RGB test against an RGBA
-// reference, NaN and out-of-range pixels, another ppd; copies share the prepared planes; size and
-// channel mismatches throw as flip_ldr does.
+// A kept prepared reference (flip_ldr prepares a fresh one per call) gives flip_ldr's map and mean bit
+// for bit on every later comparison: several test images against one reference and its copy (shared
+// planes, nothing mutated between calls), a multi-threaded size and a single-band one (under 64 rows),
+// RGB test against an RGBA reference, NaN and out-of-range pixels, another ppd; size and channel
+// mismatches throw as flip_ldr does. That flip_ldr itself kept its bits: the pinned test below.
 TEST(Flip, PreparedReferenceMatchesFlipLdrBitForBit) {
     uint32_t state = 12345u;
     auto next = [&] { state = state * 1664525u + 1013904223u; return float(state >> 8) / float(1u << 24); };
-    for (const auto [w, h, ppd] : {std::tuple{160, 97, flip_ppd()}, std::tuple{37, 23, 20.0f}}) {
+    for (const auto& [w, h, ppd] : {std::tuple{160, 97, flip_ppd()}, std::tuple{37, 23, 20.0f}}) {
         Image ref(w, h, 4);
         for (float& v : ref.data) v = next();
         ref.at(3, 4)[0] = std::nanf("");
