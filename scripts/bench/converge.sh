@@ -9,8 +9,8 @@
 #      train flags). Writes OUT/SCENE.json, OUT/SCENE.csv and OUT/log.txt (the tables).
 # A dry run on the build machine: BACKEND=cpu DEVICE=cpu WIDTH=32 HEIGHT=18 FROM=1 SPP=2 REF_SPP=4
 #      TRAIN_ARGS="--steps 20 --batch 256 --nodes 63" NBVH=build/app/nbvh scripts/bench/converge.sh OUT default
-# Estimated on the H100 from the study's frame times: ~5 minutes for the three scenes.
-# Plot afterwards, on the build machine: scripts/bench/plot_convergence.py OUT/*.json results/study/convergence.png
+# Measured on the H100 (2026-11-26, results/study/convergence/log.txt): 124 + 151 + 90 = 365 s for the three scenes.
+# Plot afterwards, on the build machine: scripts/bench/plot_convergence.py OUT/*.json results/study/convergence/convergence.png
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 OUT=$1
