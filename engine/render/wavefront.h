@@ -32,10 +32,10 @@ struct RenderOptions {
     uint32_t max_depth = 8;          // path segments (1: emitters and environment seen directly)
     uint32_t seed = 0;
     uint32_t rr_start_depth = 3;     // Russian roulette from this segment on
-    // Rays per queue (pixels per wave), further bounded by the device's storage-buffer range (lavapipe:
-    // under 1M). 4M keeps a 1080p or 1440p frame in one wave on GPUs: on the H200 two 1M waves made
-    // the 1080p classical frame ~1.5x slower than one (results/neural/README.md, v12 vs v13).
-    uint32_t max_wave_pixels = 1u << 22;
+    // Paths per wave (rays per queue), further bounded by the device's storage-buffer range (lavapipe:
+    // under 1M) and the statistics counters. 8M holds four samples of a 1080p frame: the deep bounces'
+    // latency-bound passes are then paid once per four samples (wavefront.cpp, the capacity).
+    uint32_t max_wave_pixels = 1u << 23;
     NeuralRenderOptions neural;      // hybrid (model) or classical-reference render of neural instances
     // Texel buffer or sampled-image array (texture_path.h): auto takes the array where the device can.
     TexturePathRequest texture_path = TexturePathRequest::automatic;

@@ -99,6 +99,7 @@ struct DeviceFeatures {
     uint32_t max_shared_memory = 0;          // bytes per workgroup
     uint64_t max_storage_buffer_range = 0;   // bytes per storage-buffer binding
     uint64_t max_allocation_size = 0;        // bytes per VkDeviceMemory
+    uint64_t device_local_bytes = 0;         // the largest device-local memory heap (0: unknown)
     uint32_t max_push_constants = 0;         // bytes
     uint32_t max_workgroup_invocations = 0;
     uint32_t max_workgroup_count[3] = {0, 0, 0};

@@ -203,6 +203,11 @@ void Context::create_device(const std::vector<std::string>& extra_extensions) {
     d.max_shared_memory = props.limits.maxComputeSharedMemorySize;
     d.max_storage_buffer_range = props.limits.maxStorageBufferRange;
     d.max_allocation_size = p11.maxMemoryAllocationSize;
+    VkPhysicalDeviceMemoryProperties mem{};
+    vkGetPhysicalDeviceMemoryProperties(physical_, &mem);
+    for (uint32_t h = 0; h < mem.memoryHeapCount; ++h)
+        if (mem.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+            d.device_local_bytes = std::max<uint64_t>(d.device_local_bytes, mem.memoryHeaps[h].size);
     d.max_push_constants = props.limits.maxPushConstantsSize;
     d.max_workgroup_invocations = props.limits.maxComputeWorkGroupInvocations;
     for (int i = 0; i < 3; ++i) d.max_workgroup_count[i] = props.limits.maxComputeWorkGroupCount[i];
