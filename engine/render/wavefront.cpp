@@ -80,14 +80,16 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     // the H200 (results/perf/frame_depths.md) bounces 3-7 of a 1080p classical sample carried 1.5 % of
     // its rays and 30 % of its 5.98 ms (~0.19 ms per traverse or shadow pass whether it held 44k rays or
     // 2k). A wave of several samples pays that tail once for all of them: --wave-pixels paths (default
-    // ~8M: 4 samples of 1080p), at most 16 samples and 16M paths per wave, fewer where the 32-bit
+    // 16M: 8 samples of 1080p), at most 16 samples and 16M paths per wave, fewer where the 32-bit
     // statistics counters (counter_safe_paths) or the device's storage-buffer range say so.
     constexpr uint64_t FULL_WAVE_PATHS = 1u << 24;
     constexpr uint64_t MAX_WAVE_SAMPLES = 16;
     const uint64_t max_paths =
         std::min<uint64_t>(std::max<uint32_t>(options_.max_wave_pixels, 64), counter_safe_paths(options_));
-    const uint64_t wave_samples =
-        std::clamp<uint64_t>(std::min(FULL_WAVE_PATHS, max_paths) / pixels, 1, MAX_WAVE_SAMPLES);
+    // No more samples per wave than options.spp: a renderer built for one sample per call (the viewer)
+    // keeps one sample's queues (more samples per call then take more waves, same image).
+    const uint64_t wave_samples = std::clamp<uint64_t>(std::min(FULL_WAVE_PATHS, max_paths) / pixels, 1,
+                                                       std::min<uint64_t>(MAX_WAVE_SAMPLES, options_.spp));
     uint64_t cap = std::min<uint64_t>(pixels * wave_samples, max_paths);
     cap = std::min<uint64_t>(cap, range / (2ull * NB_RAY_WORDS * 4ull));
     // Hybrid renders keep a neural state per path and per shadow ray in one binding (neural_stage.h).
@@ -102,8 +104,8 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
             cap = std::min<uint64_t>(cap, uint64_t(dev.max_workgroup_count[0]) * NB_NEURAL_GROUP / k);
     }
     // The queues of a wave take at most a quarter of the GPU's memory (188 bytes per classical path,
-    // ~730 per hybrid one with 4 leaves per round: an 8 GiB card holds ~11M / ~3M, one sample of 1080p
-    // per hybrid wave): scene, textures and model keep the rest.
+    // ~520 per hybrid one with 2 leaves per round: an 8 GiB card holds ~11M / ~4M, one or two samples of
+    // 1080p per hybrid wave): scene, textures and model keep the rest.
     if (dev.device_local_bytes) {
         uint64_t per_path = 4ull * (2 * NB_RAY_WORDS + NB_HIT_WORDS + NB_SHADOW_WORDS + 3);
         if (options_.neural.model)

@@ -33,9 +33,11 @@ struct RenderOptions {
     uint32_t seed = 0;
     uint32_t rr_start_depth = 3;     // Russian roulette from this segment on
     // Paths per wave (rays per queue), further bounded by the device's storage-buffer range (lavapipe:
-    // under 1M) and the statistics counters. 8M holds four samples of a 1080p frame: the deep bounces'
-    // latency-bound passes are then paid once per four samples (wavefront.cpp, the capacity).
-    uint32_t max_wave_pixels = 1u << 23;
+    // under 1M), one allocation's size, a quarter of the GPU's memory and the statistics counters. 16M
+    // holds eight samples of a 1080p frame: the deep bounces' latency-bound passes are then paid once per
+    // eight samples (wavefront.cpp, the capacity; results/perf/frame_depths.md). Queue memory at 16M:
+    // ~3.2 GB classical, ~8.8 GB hybrid (2 leaves per round).
+    uint32_t max_wave_pixels = 1u << 24;
     NeuralRenderOptions neural;      // hybrid (model) or classical-reference render of neural instances
     // Texel buffer or sampled-image array (texture_path.h): auto takes the array where the device can.
     TexturePathRequest texture_path = TexturePathRequest::automatic;

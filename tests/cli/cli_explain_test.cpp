@@ -30,7 +30,7 @@ TEST(CliExplain, HybridRenderListsTheNeuralPasses) {
     // lavapipe has no cooperative matrices: auto picks the scalar path, as the renderer would.
     EXPECT_TRUE(has(o, "MLP path        scalar")) << o;
     EXPECT_TRUE(has(o, "camera rays 1, after the first hit 0 (the model has 2")) << o;
-    EXPECT_TRUE(has(o, "at most 8, 4 queued per round: 2 batched rounds")) << o;
+    EXPECT_TRUE(has(o, "at most 8, 2 queued per round: 4 batched rounds")) << o; // the defaults
     for (const char* pass :
          {"passes/neural_traverse.comp", "passes/neural_args.comp", "passes/neural_query_scalar.comp",
           "passes/neural_tail.comp", "passes/neural_shadow.comp", "passes/shade.comp"})
@@ -66,9 +66,9 @@ TEST(CliExplain, SecondaryRaysTakeTheCoarsestLodByDefault) {
 
 TEST(CliExplain, LeavesPerRoundComeFromTheRenderersStage) {
     // --neural-leaves-per-round reaches the renderer's stage (it was a hidden environment variable).
-    const auto r = run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round", "2"}), 60.0);
+    const auto r = run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round", "3"}), 60.0);
     ASSERT_EQ(r.exit_code, 0) << r.describe();
-    EXPECT_TRUE(has(r.out, "at most 8, 2 queued per round: 4 batched rounds")) << r.out;
+    EXPECT_TRUE(has(r.out, "at most 8, 3 queued per round: 3 batched rounds")) << r.out;
     const auto bad = run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round", "9"}), 60.0);
     EXPECT_EQ(check_clean_error(bad, {"--neural-leaves-per-round"}, false), "") << bad.describe();
 }
