@@ -1,4 +1,5 @@
 #include "engine/render/wavefront.h"
+#include "engine/render/wave_plan.h"
 
 #include <algorithm>
 #include <chrono>
@@ -44,17 +45,6 @@ void set_camera_params(GpuFrameParams& p, const Camera& camera, float aspect) {
     p.cam_up = basis.up;
 }
 
-// Paths one wave may hold: the GPU's statistics counters are 32-bit and read after each submission, so
-// none may grow by 2^31 within one. A path adds at most 2 * max_depth rays (path and shadow), and in a
-// hybrid render up to the leaf budget's queries per ray. Bounded with the options the renderer is built
-// with (apply() may raise depth or budget later: the statistics could then wrap on pathological
-// scenes, the image cannot).
-uint64_t counter_safe_paths(const RenderOptions& o) {
-    const uint64_t queries = o.neural.model ? o.neural.max_rounds : 0;
-    const uint64_t per_path = 2ull * std::max(o.max_depth, 1u) * (1ull + queries);
-    return std::max<uint64_t>((1ull << 31) / per_path, 64);
-}
-
 } // namespace
 
 WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene, const SceneAccel& accel,
@@ -68,53 +58,16 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     const vk::DeviceFeatures& dev = ctx_.features();
     if (!dev.scalar_layout) throw Error("the Vulkan device lacks scalarBlockLayout, which every pass needs");
     const uint64_t pixels = uint64_t(options_.width) * options_.height;
-    // Bytes one buffer may hold: a storage binding's range and one allocation's size (NVIDIA: 4096 and
-    // 4094 MiB; a 16M-path hybrid wave's pending pairs sized to the first failed on the second).
-    uint64_t range = dev.max_storage_buffer_range ? dev.max_storage_buffer_range : (128ull << 20);
-    if (dev.max_allocation_size) range = std::min(range, dev.max_allocation_size);
+    const WaveLimits limits = wave_limits(dev);
+    const uint64_t range = limits.buffer_bytes; // one buffer's bytes
     if (pixels * sizeof(vec4) > range)
         throw Error(strfmt("image of %llu pixels exceeds the device's storage-buffer range (%llu MiB)",
                            (unsigned long long)pixels, (unsigned long long)(range >> 20)));
-    // Paths per wave (the queues' capacity): every pixel once, or several samples of each. A pass costs
-    // its work plus the latency of its slowest warp, and the deep bounces' few rays are all latency: on
-    // the H200 (results/perf/frame_depths.md) bounces 3-7 of a 1080p classical sample carried 1.5 % of
-    // its rays and 30 % of its 5.98 ms (~0.19 ms per traverse or shadow pass whether it held 44k rays or
-    // 2k). A wave of several samples pays that tail once for all of them: --wave-pixels paths (default
-    // 16M: 8 samples of 1080p), at most 16 samples and 16M paths per wave, fewer where the 32-bit
-    // statistics counters (counter_safe_paths) or the device's storage-buffer range say so.
-    constexpr uint64_t FULL_WAVE_PATHS = 1u << 24;
-    constexpr uint64_t MAX_WAVE_SAMPLES = 16;
-    const uint64_t max_paths =
-        std::min<uint64_t>(std::max<uint32_t>(options_.max_wave_pixels, 64), counter_safe_paths(options_));
-    // No more samples per wave than options.spp: a renderer built for one sample per call (the viewer)
-    // keeps one sample's queues (more samples per call then take more waves, same image).
-    const uint64_t wave_samples = std::clamp<uint64_t>(std::min(FULL_WAVE_PATHS, max_paths) / pixels, 1,
-                                                       std::min<uint64_t>(MAX_WAVE_SAMPLES, options_.spp));
-    uint64_t cap = std::min<uint64_t>(pixels * wave_samples, max_paths);
-    cap = std::min<uint64_t>(cap, range / (2ull * NB_RAY_WORDS * 4ull));
-    // Hybrid renders keep a neural state per path and per shadow ray in one binding (neural_stage.h).
-    // With a model the neural state is allocated also for a classical start: the renderer switches
-    // between hybrid and classical without a rebuild (apply()).
-    if (options_.neural.model) {
-        cap = std::min<uint64_t>(cap, range / (2ull * sizeof(GpuNeuralRayState)));
-        const uint64_t k = effective_leaves_per_round(options_.neural);
-        cap = std::min<uint64_t>(cap, range / (2ull * k * sizeof(GpuPendingLeaf)));
-        // The query pass is dispatched indirectly over up to k pairs per ray (not checked on the host).
-        if (dev.max_workgroup_count[0] > 0)
-            cap = std::min<uint64_t>(cap, uint64_t(dev.max_workgroup_count[0]) * NB_NEURAL_GROUP / k);
-    }
-    // The queues of a wave take at most a quarter of the GPU's memory (188 bytes per classical path,
-    // ~520 per hybrid one with 2 leaves per round: an 8 GiB card holds ~11M / ~4M, one or two samples of
-    // 1080p per hybrid wave): scene, textures and model keep the rest.
-    if (dev.device_local_bytes) {
-        uint64_t per_path = 4ull * (2 * NB_RAY_WORDS + NB_HIT_WORDS + NB_SHADOW_WORDS + 3);
-        if (options_.neural.model)
-            per_path += 2ull * sizeof(GpuNeuralRayState) +
-                        2ull * effective_leaves_per_round(options_.neural) * sizeof(GpuPendingLeaf);
-        cap = std::min<uint64_t>(cap, std::max<uint64_t>(dev.device_local_bytes / 4 / per_path, 64));
-    }
-    capacity_ = uint32_t(cap);
-    wave_samples_ = cap >= pixels ? uint32_t(std::min<uint64_t>(wave_samples, cap / pixels)) : 1u;
+    // Paths per wave and samples of every pixel per wave (wave_plan.h: the deep bounces' latency paid
+    // once for several samples, within the device's and the counters' limits).
+    const WavePlan plan = plan_wave(pixels, options_, limits);
+    capacity_ = plan.capacity;
+    wave_samples_ = plan.samples;
 
     features_ = derive_features(scene, environment);
     // Textures: one texel buffer, or one image each in a sampled-image array (texture_path.h).

@@ -1,0 +1,65 @@
+#include "engine/render/wave_plan.h"
+
+#include <algorithm>
+
+#include "engine/render/neural_stage.h"
+#include "shaders/shared/neural_gpu.h"
+#include "shaders/shared/wavefront_gpu.h"
+
+namespace nbvh::render {
+
+WaveLimits wave_limits(const vk::DeviceFeatures& dev) {
+    WaveLimits l;
+    // NVIDIA: a 4096-MiB binding range but 4094-MiB allocations (a 16M-path hybrid wave's pending pairs,
+    // sized to the first, failed on the second).
+    if (dev.max_storage_buffer_range) l.buffer_bytes = dev.max_storage_buffer_range;
+    if (dev.max_allocation_size) l.buffer_bytes = std::min(l.buffer_bytes, dev.max_allocation_size);
+    l.device_local_bytes = dev.device_local_bytes;
+    l.max_workgroups_x = dev.max_workgroup_count[0];
+    return l;
+}
+
+uint64_t wave_bytes_per_path(const RenderOptions& o) {
+    uint64_t bytes = 4ull * (2 * NB_RAY_WORDS + NB_HIT_WORDS + NB_SHADOW_WORDS + 3);
+    if (o.neural.model)
+        bytes += 2ull * sizeof(GpuNeuralRayState) + 2ull * effective_leaves_per_round(o.neural) * sizeof(GpuPendingLeaf);
+    return bytes;
+}
+
+uint64_t counter_safe_paths(const RenderOptions& o) {
+    // Each counter on its own: rays (path or shadow) grow by at most 2 per bounce, queries by at most
+    // the leaf budget per path and shadow ray.
+    const uint64_t per_bounce = o.neural.model ? std::max(o.neural.max_rounds, 1u) : 1u;
+    const uint64_t per_path = 2ull * std::max(o.max_depth, 1u) * per_bounce;
+    return std::max<uint64_t>((1ull << 31) / per_path, 64);
+}
+
+WavePlan plan_wave(uint64_t pixels, const RenderOptions& o, const WaveLimits& limits) {
+    pixels = std::max<uint64_t>(pixels, 1);
+    const uint64_t max_paths = std::min<uint64_t>(std::max<uint32_t>(o.max_wave_pixels, 64), counter_safe_paths(o));
+    const uint64_t samples = std::clamp<uint64_t>(std::min(NB_WAVE_MAX_PATHS, max_paths) / pixels, 1,
+                                                  std::min<uint64_t>(NB_WAVE_MAX_SAMPLES, std::max(o.spp, 1u)));
+    uint64_t cap = std::min<uint64_t>(pixels * samples, max_paths);
+    const uint64_t b = limits.buffer_bytes;
+    cap = std::min<uint64_t>(cap, b / (2ull * NB_RAY_WORDS * 4ull)); // the two path-ray queues: one binding
+    // With a model the neural state (path and shadow ray) and the pending pairs are one binding each,
+    // allocated also for a classical start (apply() switches without a rebuild).
+    if (o.neural.model) {
+        const uint64_t k = effective_leaves_per_round(o.neural);
+        cap = std::min<uint64_t>(cap, b / (2ull * sizeof(GpuNeuralRayState)));
+        cap = std::min<uint64_t>(cap, b / (2ull * k * sizeof(GpuPendingLeaf)));
+        // The query pass is dispatched indirectly over up to k pairs per ray (not checked on the host).
+        if (limits.max_workgroups_x) cap = std::min<uint64_t>(cap, uint64_t(limits.max_workgroups_x) * NB_NEURAL_GROUP / k);
+    }
+    // The queues take at most a quarter of the GPU's memory (188 bytes per classical path, ~520 per
+    // hybrid one with 2 leaves per round: an 8 GiB card holds ~11M / ~4M paths).
+    if (limits.device_local_bytes)
+        cap = std::min<uint64_t>(cap, limits.device_local_bytes / 4 / wave_bytes_per_path(o));
+    cap = std::clamp<uint64_t>(cap, 64, 0xFFFFFFFFull);
+    WavePlan plan;
+    plan.capacity = uint32_t(cap);
+    plan.samples = cap >= pixels ? uint32_t(std::min<uint64_t>(samples, cap / pixels)) : 1u;
+    return plan;
+}
+
+} // namespace nbvh::render

@@ -1,0 +1,143 @@
+// The wave plan (engine/render/wave_plan.h): how many paths a wave holds and how many samples of every
+// pixel it traces, against the limits that bound it. Pure arithmetic, no GPU: the hard cases are the
+// devices' limits (NVIDIA's 4094-MiB allocations, lavapipe's 128-MiB bindings, small cards) and the
+// extreme options (1 spp, max depth 256, a 256-leaf budget, a one-pixel image, a 16k x 16k one).
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "engine/neural/model_file.h"
+#include "engine/render/neural_stage.h"
+#include "engine/render/wave_plan.h"
+#include "shaders/shared/neural_gpu.h"
+#include "shaders/shared/wavefront_gpu.h"
+
+using namespace nbvh;
+using namespace nbvh::render;
+
+namespace {
+
+constexpr uint64_t P1080 = 1920ull * 1080;
+constexpr uint64_t MIB = 1ull << 20, GIB = 1ull << 30;
+
+WaveLimits h100() { return WaveLimits{4094 * MIB, 80 * GIB, 0x7FFFFFFFu}; }
+
+RenderOptions opts(uint32_t spp = 16, const NeuralModel* model = nullptr, uint32_t k = 2) {
+    RenderOptions o;
+    o.spp = spp;
+    o.neural.model = model;
+    o.neural.leaves_per_round = k;
+    return o;
+}
+
+// Every buffer sized by the capacity fits one buffer, the queues a quarter of the GPU, the counters.
+void expect_within_limits(uint64_t pixels, const RenderOptions& o, const WaveLimits& l, const WavePlan& p) {
+    SCOPED_TRACE(testing::Message() << pixels << " pixels, spp " << o.spp << ", depth " << o.max_depth);
+    ASSERT_GE(p.capacity, 64u);
+    ASSERT_GE(p.samples, 1u);
+    EXPECT_LE(p.samples, NB_WAVE_MAX_SAMPLES);
+    EXPECT_LE(p.samples, std::max(o.spp, 1u));
+    if (p.samples > 1) {
+        EXPECT_LE(uint64_t(p.samples) * pixels, p.capacity);
+    }
+    EXPECT_LE(p.capacity, std::max<uint64_t>(o.max_wave_pixels, 64));
+    if (p.capacity > 64) {
+        EXPECT_LE(2ull * NB_RAY_WORDS * 4 * p.capacity, l.buffer_bytes);
+        EXPECT_LE(p.capacity, counter_safe_paths(o));
+        if (l.device_local_bytes) {
+            EXPECT_LE(wave_bytes_per_path(o) * p.capacity, l.device_local_bytes / 4);
+        }
+        if (o.neural.model) {
+            const uint64_t k = o.neural.leaves_per_round;
+            EXPECT_LE(2ull * k * sizeof(GpuPendingLeaf) * p.capacity, l.buffer_bytes);
+            EXPECT_LE(2ull * sizeof(GpuNeuralRayState) * p.capacity, l.buffer_bytes);
+        }
+    }
+}
+
+} // namespace
+
+TEST(WavePlan, FullHdTakesEightSamplesPerWaveOnALargeGpu) {
+    const NeuralModel model;
+    for (const NeuralModel* m : {static_cast<const NeuralModel*>(nullptr), &model}) {
+        const WavePlan p = plan_wave(P1080, opts(16, m), h100());
+        EXPECT_EQ(p.samples, 8u) << (m ? "hybrid" : "classical");
+        EXPECT_EQ(p.capacity, 8 * P1080);
+        expect_within_limits(P1080, opts(16, m), h100(), p);
+    }
+}
+
+TEST(WavePlan, OneSamplePerCallKeepsOneSamplesQueues) {
+    const WavePlan p = plan_wave(P1080, opts(1), h100()); // the viewer
+    EXPECT_EQ(p.samples, 1u);
+    EXPECT_EQ(p.capacity, P1080);
+    EXPECT_EQ(plan_wave(P1080, opts(3), h100()).samples, 3u);
+}
+
+TEST(WavePlan, SmallImagesStopAtSixteenSamples) {
+    const WavePlan p = plan_wave(960ull * 540, opts(512), h100());
+    EXPECT_EQ(p.samples, 16u);
+    EXPECT_EQ(p.capacity, 16ull * 960 * 540);
+    const WavePlan one = plan_wave(1, opts(512), h100()); // one pixel: the 64-path floor, 16 samples
+    EXPECT_EQ(one.samples, 16u);
+    EXPECT_GE(one.capacity, 64u);
+}
+
+// Four leaves per round at 1080p: 8 samples would need 2 x 4 x 52 bytes x 16.6M = 6.4 GiB of pending
+// pairs in one buffer; the wave shrinks to what 4094 MiB holds (it failed with a one-line allocation
+// error before the plan knew the allocation limit).
+TEST(WavePlan, PendingPairsStayWithinOneAllocation) {
+    const NeuralModel model;
+    const WavePlan p = plan_wave(P1080, opts(16, &model, 4), h100());
+    EXPECT_EQ(p.capacity, 4094 * MIB / (2 * 4 * sizeof(GpuPendingLeaf)));
+    EXPECT_EQ(p.samples, 4u);
+    expect_within_limits(P1080, opts(16, &model, 4), h100(), p);
+}
+
+TEST(WavePlan, SmallGpusGetSmallerWaves) {
+    const NeuralModel model;
+    const WaveLimits card{4094 * MIB, 8 * GIB, 0x7FFFFFFFu};
+    const WavePlan hybrid = plan_wave(P1080, opts(16, &model), card);
+    EXPECT_LE(hybrid.samples, 1u);
+    EXPECT_EQ(hybrid.capacity, 2 * GIB / wave_bytes_per_path(opts(16, &model)));
+    const WavePlan classical = plan_wave(P1080, opts(16), card);
+    EXPECT_EQ(classical.samples, 5u); // 2 GiB / 188 bytes = 11.4M paths
+    expect_within_limits(P1080, opts(16, &model), card, hybrid);
+    expect_within_limits(P1080, opts(16), card, classical);
+}
+
+TEST(WavePlan, LavapipeBindingsBoundTheQueues) {
+    const WaveLimits lavapipe{128 * MIB, 0, 65535};
+    const WavePlan p = plan_wave(P1080, opts(16), lavapipe);
+    EXPECT_EQ(p.capacity, 128 * MIB / (2 * NB_RAY_WORDS * 4)); // under one 1080p sample: several waves
+    EXPECT_EQ(p.samples, 1u);
+}
+
+TEST(WavePlan, DeepPathsAndLargeLeafBudgetsKeepTheCountersFromWrapping) {
+    const NeuralModel model;
+    RenderOptions o = opts(16, &model);
+    o.max_depth = 256;
+    o.neural.max_rounds = 256;
+    const WavePlan p = plan_wave(P1080, o, h100());
+    EXPECT_EQ(p.capacity, (1ull << 31) / (2ull * 256 * 256));
+    EXPECT_EQ(p.samples, 1u);
+    // Each path adds at most 2 x 256 rays x 256 queries to the query counter: under 2^31 per wave.
+    EXPECT_LE(uint64_t(p.capacity) * 2 * 256 * 256, 1ull << 31);
+}
+
+TEST(WavePlan, RandomOptionsAndLimitsStayWithinEveryBound) {
+    const NeuralModel model;
+    std::mt19937_64 rng(7);
+    auto pick = [&](uint64_t lo, uint64_t hi) { return std::uniform_int_distribution<uint64_t>(lo, hi)(rng); };
+    for (int i = 0; i < 20000; ++i) {
+        const uint64_t pixels = pick(0, 3) == 0 ? pick(1, 64) : pick(1, 16384ull * 16384);
+        RenderOptions o = opts(uint32_t(pick(1, 4096)), pick(0, 1) ? &model : nullptr, uint32_t(pick(1, NB_NL_MAX_LEAVES_PER_ROUND)));
+        o.max_depth = uint32_t(pick(1, 256));
+        o.neural.max_rounds = uint32_t(pick(1, 256));
+        o.max_wave_pixels = uint32_t(pick(64, 1u << 26));
+        const WaveLimits l{pick(16 * MIB, 8 * GIB), pick(0, 1) ? pick(256 * MIB, 192 * GIB) : 0, uint32_t(pick(0, 0x7FFFFFFF))};
+        const WavePlan p = plan_wave(pixels, o, l);
+        expect_within_limits(pixels, o, l, p);
+        if (HasFatalFailure() || HasNonfatalFailure()) break;
+    }
+}
