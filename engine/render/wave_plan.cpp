@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "engine/render/gpu_memory.h"
 #include "engine/render/neural_stage.h"
 #include "shaders/shared/neural_gpu.h"
 #include "shaders/shared/wavefront_gpu.h"
@@ -20,10 +21,8 @@ WaveLimits wave_limits(const vk::DeviceFeatures& dev) {
 }
 
 uint64_t wave_bytes_per_path(const RenderOptions& o) {
-    uint64_t bytes = 4ull * (2 * NB_RAY_WORDS + NB_HIT_WORDS + NB_SHADOW_WORDS + 3);
-    if (o.neural.model)
-        bytes += 2ull * sizeof(GpuNeuralRayState) + 2ull * effective_leaves_per_round(o.neural) * sizeof(GpuPendingLeaf);
-    return bytes;
+    const uint64_t classical = 4ull * (2 * NB_RAY_WORDS + NB_HIT_WORDS + NB_SHADOW_WORDS + 3);
+    return classical + (o.neural.model ? neural_scratch_bytes_per_ray(effective_leaves_per_round(o.neural)) : 0);
 }
 
 uint64_t counter_safe_paths(const RenderOptions& o) {
@@ -42,6 +41,8 @@ WavePlan plan_wave(uint64_t pixels, const RenderOptions& o, const WaveLimits& li
     uint64_t cap = std::min<uint64_t>(pixels * samples, max_paths);
     const uint64_t b = limits.buffer_bytes;
     cap = std::min<uint64_t>(cap, b / (2ull * NB_RAY_WORDS * 4ull)); // the two path-ray queues: one binding
+    // Every pass dispatches one invocation per path (camera rays directly, the others indirectly).
+    if (limits.max_workgroups_x) cap = std::min<uint64_t>(cap, uint64_t(limits.max_workgroups_x) * NB_WAVEFRONT_GROUP);
     // With a model the neural state (path and shadow ray) and the pending pairs are one binding each,
     // allocated also for a classical start (apply() switches without a rebuild).
     if (o.neural.model) {
@@ -57,8 +58,10 @@ WavePlan plan_wave(uint64_t pixels, const RenderOptions& o, const WaveLimits& li
         cap = std::min<uint64_t>(cap, limits.device_local_bytes / 4 / wave_bytes_per_path(o));
     cap = std::clamp<uint64_t>(cap, 64, 0xFFFFFFFFull);
     WavePlan plan;
-    plan.capacity = uint32_t(cap);
     plan.samples = cap >= pixels ? uint32_t(std::min<uint64_t>(samples, cap / pixels)) : 1u;
+    // No slot a wave would not use (an image of several waves keeps the bound: its last wave is partial).
+    if (cap >= pixels) cap = std::max<uint64_t>(pixels * plan.samples, 64);
+    plan.capacity = uint32_t(cap);
     return plan;
 }
 

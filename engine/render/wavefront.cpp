@@ -61,7 +61,7 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     const WaveLimits limits = wave_limits(dev);
     const uint64_t range = limits.buffer_bytes; // one buffer's bytes
     if (pixels * sizeof(vec4) > range)
-        throw Error(strfmt("image of %llu pixels exceeds the device's storage-buffer range (%llu MiB)",
+        throw Error(strfmt("image of %llu pixels exceeds what one buffer of the device holds (%llu MiB)",
                            (unsigned long long)pixels, (unsigned long long)(range >> 20)));
     // Paths per wave and samples of every pixel per wave (wave_plan.h: the deep bounces' latency paid
     // once for several samples, within the device's and the counters' limits).
@@ -215,9 +215,9 @@ void WavefrontRenderer::swap_model(const NeuralRenderOptions& n) {
 // Small images take several samples per submission: a submission's fixed cost (submit, fence wait,
 // timestamp and counter read-back) would otherwise dominate (H100, 960x540 classical: ~5.6 ms of wall
 // time per sample with one submission each; 8 per submission: 66.0 s wall for 59.6 s of GPU time at
-// 16384 spp). Bounded by pixel samples per submission so the 32-bit counters
-// cannot wrap within one (each pixel sample adds at most a few hundred to any of them) and a submission
-// stays short; an image larger than one wave takes one submission per (sample, wave) as before.
+// 16384 spp). Bounded by ~4M path samples per submission, or one wave where a wave holds more, and by
+// counter_safe_paths (wave_plan.h: no 32-bit counter can wrap within one submission); an image larger
+// than one wave takes one submission per (sample, wave) as before.
 void WavefrontRenderer::make_timer() {
     constexpr uint64_t PIXEL_SAMPLES_PER_SUBMISSION = 1u << 22;
     constexpr uint32_t MAX_SAMPLES_PER_SUBMISSION = 32;

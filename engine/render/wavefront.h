@@ -32,11 +32,11 @@ struct RenderOptions {
     uint32_t max_depth = 8;          // path segments (1: emitters and environment seen directly)
     uint32_t seed = 0;
     uint32_t rr_start_depth = 3;     // Russian roulette from this segment on
-    // Paths per wave (rays per queue), further bounded by the device's storage-buffer range (lavapipe:
-    // under 1M), one allocation's size, a quarter of the GPU's memory and the statistics counters. 16M
-    // holds eight samples of a 1080p frame: the deep bounces' latency-bound passes are then paid once per
-    // eight samples (wavefront.cpp, the capacity; results/perf/frame_depths.md). Queue memory at 16M:
-    // ~3.2 GB classical, ~8.8 GB hybrid (2 leaves per round).
+    // Paths per wave (rays per queue), further bounded by the device (one buffer's bytes, a quarter of
+    // its memory, the dispatch limits) and the statistics counters; a wave of several samples of every
+    // pixel holds at most 16M paths (engine/render/wave_plan.h). 16M: eight samples of a 1080p frame, so
+    // the deep bounces' latency-bound passes are paid once per eight samples (results/perf/
+    // frame_depths.md). Queue memory at 16M: ~3.2 GB classical, ~8.8 GB hybrid (2 leaves per round).
     uint32_t max_wave_pixels = 1u << 24;
     NeuralRenderOptions neural;      // hybrid (model) or classical-reference render of neural instances
     // Texel buffer or sampled-image array (texture_path.h): auto takes the array where the device can.

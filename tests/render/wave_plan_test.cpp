@@ -37,20 +37,33 @@ void expect_within_limits(uint64_t pixels, const RenderOptions& o, const WaveLim
     ASSERT_GE(p.samples, 1u);
     EXPECT_LE(p.samples, NB_WAVE_MAX_SAMPLES);
     EXPECT_LE(p.samples, std::max(o.spp, 1u));
+    if (p.capacity >= pixels && p.capacity > 64) {
+        EXPECT_EQ(p.capacity, uint64_t(p.samples) * pixels) << "a one-wave image keeps no unused slot";
+    }
     if (p.samples > 1) {
         EXPECT_LE(uint64_t(p.samples) * pixels, p.capacity);
     }
     EXPECT_LE(p.capacity, std::max<uint64_t>(o.max_wave_pixels, 64));
-    if (p.capacity > 64) {
-        EXPECT_LE(2ull * NB_RAY_WORDS * 4 * p.capacity, l.buffer_bytes);
-        EXPECT_LE(p.capacity, counter_safe_paths(o));
+    if (p.capacity > 64) { // the bounds, restated here rather than taken from wave_plan.cpp
+        const uint64_t cap = p.capacity;
+        const bool hybrid = o.neural.model != nullptr;
+        const uint64_t k = o.neural.leaves_per_round;
+        EXPECT_LE(2ull * NB_RAY_WORDS * 4 * cap, l.buffer_bytes);
+        // No 32-bit counter grows by 2^31 within one wave: rays by 2 per bounce, queries by the leaf budget.
+        EXPECT_LE(cap * 2 * o.max_depth * (hybrid ? o.neural.max_rounds : 1u), 1ull << 31);
+        const uint64_t bytes = 188 + (hybrid ? 2 * 64 + 2 * k * 52 : 0); // queues + neural state + pending pairs
         if (l.device_local_bytes) {
-            EXPECT_LE(wave_bytes_per_path(o) * p.capacity, l.device_local_bytes / 4);
+            EXPECT_LE(bytes * cap, l.device_local_bytes / 4);
         }
-        if (o.neural.model) {
-            const uint64_t k = o.neural.leaves_per_round;
-            EXPECT_LE(2ull * k * sizeof(GpuPendingLeaf) * p.capacity, l.buffer_bytes);
-            EXPECT_LE(2ull * sizeof(GpuNeuralRayState) * p.capacity, l.buffer_bytes);
+        if (l.max_workgroups_x) {
+            EXPECT_LE(cap, uint64_t(l.max_workgroups_x) * 64) << "one invocation per path per dispatch";
+            if (hybrid) {
+                EXPECT_LE(cap * k, uint64_t(l.max_workgroups_x) * NB_NEURAL_GROUP);
+            }
+        }
+        if (hybrid) {
+            EXPECT_LE(2ull * k * sizeof(GpuPendingLeaf) * cap, l.buffer_bytes);
+            EXPECT_LE(2ull * sizeof(GpuNeuralRayState) * cap, l.buffer_bytes);
         }
     }
 }
@@ -89,8 +102,9 @@ TEST(WavePlan, SmallImagesStopAtSixteenSamples) {
 TEST(WavePlan, PendingPairsStayWithinOneAllocation) {
     const NeuralModel model;
     const WavePlan p = plan_wave(P1080, opts(16, &model, 4), h100());
-    EXPECT_EQ(p.capacity, 4094 * MIB / (2 * 4 * sizeof(GpuPendingLeaf)));
-    EXPECT_EQ(p.samples, 4u);
+    EXPECT_EQ(p.samples, 4u); // 4094 MiB / 416 bytes = 10.3M paths: 4 samples, trimmed to them
+    EXPECT_EQ(p.capacity, 4 * P1080);
+    EXPECT_LE(2 * 4 * sizeof(GpuPendingLeaf) * p.capacity, 4094 * MIB);
     expect_within_limits(P1080, opts(16, &model, 4), h100(), p);
 }
 
@@ -98,8 +112,8 @@ TEST(WavePlan, SmallGpusGetSmallerWaves) {
     const NeuralModel model;
     const WaveLimits card{4094 * MIB, 8 * GIB, 0x7FFFFFFFu};
     const WavePlan hybrid = plan_wave(P1080, opts(16, &model), card);
-    EXPECT_LE(hybrid.samples, 1u);
-    EXPECT_EQ(hybrid.capacity, 2 * GIB / wave_bytes_per_path(opts(16, &model)));
+    EXPECT_EQ(hybrid.samples, 1u); // 2 GiB / 524 bytes = 4.1M paths: one sample of 1080p
+    EXPECT_EQ(hybrid.capacity, P1080);
     const WavePlan classical = plan_wave(P1080, opts(16), card);
     EXPECT_EQ(classical.samples, 5u); // 2 GiB / 188 bytes = 11.4M paths
     expect_within_limits(P1080, opts(16, &model), card, hybrid);
@@ -111,6 +125,17 @@ TEST(WavePlan, LavapipeBindingsBoundTheQueues) {
     const WavePlan p = plan_wave(P1080, opts(16), lavapipe);
     EXPECT_EQ(p.capacity, 128 * MIB / (2 * NB_RAY_WORDS * 4)); // under one 1080p sample: several waves
     EXPECT_EQ(p.samples, 1u);
+}
+
+// The spec's minimum maxComputeWorkGroupCount (65535, e.g. Intel's Linux driver): 65535 x 64 paths per
+// dispatch, classical waves included (the camera pass dispatches one invocation per path directly).
+TEST(WavePlan, MinimumWorkgroupCountBoundsEveryWave) {
+    const WavePlan p = plan_wave(P1080, opts(16), WaveLimits{4094 * MIB, 16 * GIB, 65535});
+    EXPECT_EQ(p.samples, 2u); // 65535 x 64 = 4.19M paths
+    EXPECT_EQ(p.capacity, 2 * P1080);
+    const WavePlan big = plan_wave(8192ull * 8192, opts(16), WaveLimits{4094 * MIB, 16 * GIB, 65535});
+    EXPECT_EQ(big.capacity, 65535ull * 64);
+    EXPECT_EQ(big.samples, 1u);
 }
 
 TEST(WavePlan, DeepPathsAndLargeLeafBudgetsKeepTheCountersFromWrapping) {
