@@ -41,8 +41,7 @@
 
 namespace nbvh::app::study {
 
-void StudyRun::run_config(size_t index, const Config& c) {
-    // Train.
+TrainOptions StudyRun::train_options(const Config& c) const {
     TrainOptions opt = default_train_options(backend_);
     opt.target_nodes = c.nodes;
     opt.network.log2_hash_size = c.hash_log2;
@@ -52,6 +51,12 @@ void StudyRun::run_config(size_t index, const Config& c) {
     opt.seed = o_.train_seed;
     opt.threads = o_.threads;
     validate(opt);
+    return opt;
+}
+
+void StudyRun::run_config(size_t index, const Config& c) {
+    // Train.
+    const TrainOptions opt = train_options(c);
     const std::string label =
         strfmt("config %zu/%zu (nodes %u, hash 2^%u)", index + 1, configs_.size(), c.nodes, c.hash_log2);
     progress_.begin(StudyTask::train, double(opt.steps) * opt.batch_size, label + ": training");

@@ -103,6 +103,7 @@ class StudyRun {
     void plan();
     void classical_side();
     void run_config(size_t index, const Config& c);
+    TrainOptions train_options(const Config& c) const; // validated (throws nbvh::Error)
     double equal_time(CameraSide& cam, double ratio, uint32_t* spp_out);
     void write_results() const;
 

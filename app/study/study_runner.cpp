@@ -173,15 +173,7 @@ void StudyRun::run() {
     for (uint32_t n : o_.nodes.empty() ? std::vector<uint32_t>{defaults.target_nodes} : o_.nodes)
         for (uint32_t h : o_.hash_log2.empty() ? std::vector<uint32_t>{default_hash} : o_.hash_log2)
             configs_.push_back({n, h});
-    for (const Config& c : configs_) { // validate every configuration before the first training
-        TrainOptions t = defaults;
-        t.target_nodes = c.nodes;
-        t.network.log2_hash_size = c.hash_log2;
-        t.lods = o_.lods;
-        if (o_.steps) t.steps = *o_.steps;
-        if (o_.batch) t.batch_size = *o_.batch;
-        validate(t);
-    }
+    for (const Config& c : configs_) train_options(c); // every configuration valid before the first training
     for (uint32_t m : ts_.meshes) {
         source_triangles_ += ts_.scene.meshes[m].triangle_count();
         source_bytes_ += render::mesh_gpu_bytes(ts_.scene.meshes[m]);
