@@ -10,32 +10,9 @@
 
 #include "engine/bvh/bvh.h"
 #include "engine/scene/scene.h"
+#include "trainer/pcg32.h"
 
 namespace nbvh {
-
-// PCG32 (O'Neill): small, fast, and splittable by stream id, so each (step, thread, slot) draws an
-// independent sequence and a run is reproducible from its seed whatever the thread count.
-class Pcg32 {
-public:
-    Pcg32(uint64_t seed, uint64_t stream) {
-        inc_ = (stream << 1u) | 1u;
-        next_u32();
-        state_ += seed;
-        next_u32();
-    }
-    uint32_t next_u32() {
-        const uint64_t old = state_;
-        state_ = old * 6364136223846793005ull + inc_;
-        const uint32_t xorshifted = uint32_t(((old >> 18u) ^ old) >> 27u);
-        const uint32_t rot = uint32_t(old >> 59u);
-        return (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
-    }
-    // Uniform in [0, 1): 24 random bits, so 1.0f is never returned.
-    float next_float() { return float(next_u32() >> 8) * (1.0f / 16777216.0f); }
-
-private:
-    uint64_t state_ = 0, inc_ = 0;
-};
 
 // Ray/box slab test with mint = -inf (notes §1: t_entry may be negative). Axis-parallel rays are
 // handled without 0*inf (an origin exactly on a face of a parallel slab counts as inside).

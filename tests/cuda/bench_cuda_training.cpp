@@ -3,6 +3,7 @@
 // 1. Step throughput at the paper's configuration (batch 2^18, 8 levels x 4 features at T = 2^18,
 //    96 -> 64x4 -> 8) on a fixed cut: full-step samples/s and a per-phase breakdown (CUDA events).
 // 2. Time to train a model of the paper's size: the official Chess schedule (~25k nodes), 10k steps.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -81,9 +82,12 @@ int main(int argc, char** argv) try {
     backend->set_timing(true);
     CudaPhaseTimes acc{};
     const uint32_t phases_n = 20;
+    uint64_t draws = 0, drawn_samples = 0; // rays drawn per trained sample (misses redrawn; keep 1 here)
     for (uint32_t s = 0; s < phases_n; ++s) {
         p.step = 200 + s;
-        backend->step(p);
+        const StepStats st = backend->step(p);
+        draws += st.draws;
+        drawn_samples += st.samples;
         const CudaPhaseTimes t = backend->phase_times();
         acc.sample += t.sample / phases_n; acc.truth += t.truth / phases_n; acc.encode += t.encode / phases_n;
         acc.mlp += t.mlp / phases_n; acc.grid_backward += t.grid_backward / phases_n;
@@ -96,6 +100,8 @@ int main(int argc, char** argv) try {
                 step_s * 1e3, full_sps * 1e-9, leaves.size(), serial_s * 1e3, opt.batch_size / serial_s * 1e-9);
     std::printf("phases (ms): sample %.3f, truth %.3f, encode %.3f, mlp %.3f, grid backward %.3f, reduce+guard+adam %.3f\n",
                 acc.sample, acc.truth, acc.encode, acc.mlp, acc.grid_backward, acc.reduce_adam);
+    const double draws_per_sample = double(draws) / double(std::max<uint64_t>(drawn_samples, 1));
+    std::printf("sampling: %.3f rays drawn per sample\n", draws_per_sample);
     std::printf("network part (encode+mlp+grid bwd+adam): %.4f G samples/s; fused MLP alone %.4f G samples/s\n",
                 net_sps * 1e-9, mlp_sps * 1e-9);
 
@@ -123,7 +129,7 @@ int main(int argc, char** argv) try {
           << opt.network.log2_hash_size << ",\n  \"step_ms\": " << step_s * 1e3 << ",\n  \"full_step_samples_per_s\": "
           << full_sps << ",\n  \"step_ms_without_prefetch\": " << serial_s * 1e3 << ",\n  \"phase_ms\": {\"sample\": " << acc.sample << ", \"truth\": " << acc.truth
           << ", \"encode\": " << acc.encode << ", \"mlp\": " << acc.mlp << ", \"grid_backward\": " << acc.grid_backward
-          << ", \"reduce_adam\": " << acc.reduce_adam << "},\n  \"network_samples_per_s\": " << net_sps
+          << ", \"reduce_adam\": " << acc.reduce_adam << "},\n  \"draws_per_sample\": " << draws_per_sample << ",\n  \"network_samples_per_s\": " << net_sps
           << ",\n  \"mlp_samples_per_s\": " << mlp_sps << ",\n  \"train_steps\": " << steps
           << ",\n  \"train_nodes\": " << final_nodes << ",\n  \"train_seconds\": " << train_s
           << ",\n  \"train_samples_per_s\": " << train_sps << ",\n  \"train_final_loss\": " << final_loss

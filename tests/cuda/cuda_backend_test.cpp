@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <numeric>
 
 #include "engine/neural/losses.h"
@@ -41,18 +42,31 @@ double rel_l2(const std::vector<float>& a, const std::vector<double>& b) {
 // The GPU's samples against the CPU backend's: same rays (same PCG32 streams; float differences in
 // sin/cos may move a rare ray, so 1 % may differ) and the same ground truth (hit, depth, normal, albedo
 // with per-hit texture lookups).
+// Also the draw counts: the GPU spreads a slot's attempts over its warp's idle lanes (sampling_kernels.cu
+// k_sample) and must count exactly the attempts up to the first kept one, per leaf and in total.
 uint32_t check_rays_and_truth(const TrainingAsset& asset, const TrainingCut& cut, const StepParams& p,
-                              const std::vector<CudaDebugSample>& samples) {
+                              const StepStats& st, const std::vector<CudaDebugSample>& samples) {
     uint32_t same = 0;
+    uint64_t draws = 0;
+    std::vector<uint32_t> leaf_draws(cut.size(), 0u);
     for (uint32_t i = 0; i < p.batch_size; ++i) {
-        Pcg32 rng(p.seed ^ (uint64_t(p.step) * 0x9E3779B97F4A7C15ull), i);
-        uint64_t draws = 0;
         const std::vector<const TrainingCut*> cuts{&cut};
-        const TrainingSample s = draw_training_sample(asset, cuts, rng, nullptr, draws);
+        const TrainingSample s = draw_training_sample(asset, cuts, {p.seed, p.step, i}, leaf_draws.data(), draws);
         if (s.leaf == samples[i].leaf && glm::length(s.origin - samples[i].origin) <= 1e-4f * glm::length(asset.bounds.extent()))
             same++;
     }
     EXPECT_GE(same, p.batch_size * 99 / 100);
+    EXPECT_GT(draws, uint64_t(p.batch_size)); // the roulette (keep 0.5 on a third of the leaves) redraws
+    // A ray moved by sin/cos rounding changes a few counts; the attempts themselves must line up.
+    EXPECT_NEAR(double(st.draws), double(draws), 0.002 * double(draws));
+    EXPECT_EQ(st.leaves.size(), leaf_draws.size());
+    if (st.leaves.size() != leaf_draws.size()) return same;
+    uint64_t off = 0, total = 0;
+    for (size_t l = 0; l < leaf_draws.size(); ++l) {
+        off += uint64_t(std::llabs(int64_t(st.leaves[l].draws) - int64_t(leaf_draws[l])));
+        total += leaf_draws[l];
+    }
+    EXPECT_LE(off, total / 200) << "per-leaf draws differ from the CPU sampler's";
 
     // 2. Ground truth: the GPU tracer agrees with the CPU tracer on hit/miss and depth.
     uint32_t hit_mismatch = 0, depth_off = 0, normal_off = 0, albedo_off = 0;
@@ -97,7 +111,7 @@ void check_against_cpu(bool deterministic, uint32_t batch) {
     std::vector<float> mlp_grad, grid_grad;
     gpu->read_last_step(samples, mlp_grad, grid_grad);
 
-    const uint32_t same = check_rays_and_truth(asset, cut, p, samples);
+    const uint32_t same = check_rays_and_truth(asset, cut, p, st, samples);
 
     // 3. Loss and gradients: CPU reference network (fp16-emulated forward = the shaders' rounding) on the
     //    GPU's samples and targets, with the initial weights (same init for the seed).
@@ -297,7 +311,7 @@ TEST(CudaBackend, MultiAssetTexturedTruthMatchesCpu) {
     std::vector<CudaDebugSample> samples;
     std::vector<float> mlp_grad, grid_grad;
     gpu->read_last_step(samples, mlp_grad, grid_grad);
-    check_rays_and_truth(asset, cut, p, samples);
+    check_rays_and_truth(asset, cut, p, st, samples);
 }
 
 } // namespace nbvh

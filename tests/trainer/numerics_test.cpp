@@ -37,7 +37,6 @@ std::vector<Case> hard_cases() {
 // Encoded inputs, ground truth and segment of drawn training samples stay finite and in range.
 void check_samples(const TrainingAsset& asset, const TrainingCut& cut) {
     const TrainingCut* cuts[1] = {&cut};
-    Pcg32 rng(3, 4);
     uint64_t draws = 0;
     // Points are computed in object space: far from the origin their rounding (a few ulps of the
     // largest coordinate) is a visible fraction of a small asset's extent. That is the asset's own
@@ -46,7 +45,7 @@ void check_samples(const TrainingAsset& asset, const TrainingCut& cut) {
     const float max_coord = std::max({std::abs(c.x), std::abs(c.y), std::abs(c.z)}) + std::max({e.x, e.y, e.z});
     const float slack = 1e-3f + 8.0f * max_coord * 1.2e-7f / std::min({e.x, e.y, e.z});
     for (int i = 0; i < 3000; ++i) {
-        const TrainingSample s = draw_training_sample(asset, cuts, rng, nullptr, draws);
+        const TrainingSample s = draw_training_sample(asset, cuts, {3, 4, uint32_t(i)}, nullptr, draws);
         ASSERT_GE(s.leaf, 0);
         ASSERT_TRUE(finite3(s.origin) && finite3(s.dir) && std::isfinite(s.length));
         vec3 p[3];

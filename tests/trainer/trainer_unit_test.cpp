@@ -96,11 +96,10 @@ TEST(TrainingRays, SurvivalRouletteRedrawsRejectedSamples) {
     cut.assign(kids, bvh.nodes.size());
     cut.keep_probability = {0.0f, 1.0f}; // leaf 0 is always rejected
     const TrainingCut* cuts[1] = {&cut};
-    Pcg32 rng(7, 1);
     uint32_t draws_per_leaf[2] = {0, 0};
     uint64_t draws = 0;
     for (int i = 0; i < 2000; ++i) {
-        const TrainingSample s = draw_training_sample(asset, cuts, rng, draws_per_leaf, draws);
+        const TrainingSample s = draw_training_sample(asset, cuts, {7, 1, uint32_t(i)}, draws_per_leaf, draws);
         ASSERT_EQ(s.leaf, 1);
         ASSERT_TRUE(std::isfinite(s.length) && s.length >= 0.0f);
     }

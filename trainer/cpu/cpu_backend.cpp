@@ -16,11 +16,12 @@
 
 namespace nbvh {
 
-TrainingSample draw_training_sample(const TrainingAsset& asset, std::span<const TrainingCut* const> cuts, Pcg32& rng,
-                                    uint32_t* leaf_draws, uint64_t& draws, uint32_t max_draws) {
+TrainingSample draw_training_sample(const TrainingAsset& asset, std::span<const TrainingCut* const> cuts,
+                                    const SampleSlot& where, uint32_t* leaf_draws, uint64_t& draws, uint32_t max_draws) {
     TrainingSample s;
     for (uint32_t attempt = 0; attempt < max_draws; ++attempt) {
         draws++;
+        Pcg32 rng = where.attempt_rng(attempt);
         const uint32_t c = cuts.size() > 1 ? std::min(uint32_t(rng.next_float() * float(cuts.size())),
                                                      uint32_t(cuts.size() - 1))
                                            : 0u;
@@ -114,10 +115,9 @@ public:
             for (uint32_t i = begin; i < end;) {
                 uint32_t n = 0;
                 for (; i < end && n < neural::kBatchTile; ++i) {
-                    // One stream per (step, slot): reproducible whatever the thread count.
-                    Pcg32 rng(params.seed ^ (uint64_t(params.step) * 0x9E3779B97F4A7C15ull), i);
-                    const TrainingSample s =
-                        draw_training_sample(asset_, params.cuts, rng, ts.leaf_draws.data(), ts.draws);
+                    // Streams per (step, slot, attempt): reproducible whatever the thread count.
+                    const TrainingSample s = draw_training_sample(asset_, params.cuts, {params.seed, params.step, i},
+                                                                  ts.leaf_draws.data(), ts.draws);
                     if (s.leaf < 0) continue; // starved (no reachable leaf): counted as not trained
                     const GroundTruth gt = trace_ground_truth(asset_, s.origin, s.dir, 0.0f, s.length);
                     nb_segment_points(asset_.encoding, s.origin, s.dir, 0.0f, s.length, queries[n].points[0],

@@ -28,7 +28,9 @@ struct TrainingSample {
 // cuts[0] the survival roulette rejects (and redraws) with 1 - keep_probability. `leaf_draws`
 // (size of cuts[0], may be null) counts every ray that met a leaf of cuts[0] first. Gives up after
 // `max_draws` rays (returns leaf = -1), so a cut that rays cannot reach never hangs training.
-TrainingSample draw_training_sample(const TrainingAsset& asset, std::span<const TrainingCut* const> cuts, Pcg32& rng,
-                                    uint32_t* leaf_draws, uint64_t& draws, uint32_t max_draws = 100000);
+// Attempt k draws its random numbers from where.attempt_rng(k) (trainer/pcg32.h).
+TrainingSample draw_training_sample(const TrainingAsset& asset, std::span<const TrainingCut* const> cuts,
+                                    const SampleSlot& where, uint32_t* leaf_draws, uint64_t& draws,
+                                    uint32_t max_draws = 100000);
 
 } // namespace nbvh

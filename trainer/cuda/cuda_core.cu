@@ -150,9 +150,10 @@ public:
             b.scalars.alloc(4);
         }
         mlp_prepare();
-        node_boxes_.upload(a.node_boxes);
-        children_.alloc(a.node_children.size() / 2);
-        NBVH_CUDA_CHECK(cudaMemcpy(children_.p, a.node_children.data(), a.node_children.size() * 4, cudaMemcpyHostToDevice));
+        // The base BVH stays on the host: each cut's compact tree is built from it (set_cuts).
+        base_boxes_ = a.node_boxes;
+        base_children_ = a.node_children;
+        part_roots_ = a.part_roots;
         mesh_nodes_.upload(a.mesh_nodes);
         tri_v_.upload(a.tri_vertices);
         tri_n_.upload(a.tri_normals);
@@ -163,9 +164,6 @@ public:
         tex_info_.upload(a.texture_info.empty() ? std::vector<uint32_t>{0u, 1u, 1u} : a.texture_info);
         srgb_.upload(a.srgb_table.data(), a.srgb_table.size());
         tri_g_.upload(a.tri_geo_normal);
-        da_.node_boxes = node_boxes_.p;
-        da_.children = children_.p;
-        da_.base_nodes = uint32_t(a.node_boxes.size() / 6);
         da_.mesh_nodes = a.mesh_nodes.empty() ? nullptr : mesh_nodes_.p;
         da_.tri_v = tri_v_.p; da_.tri_n = tri_n_.p; da_.tri_a = tri_a_.p; da_.tri_g = tri_g_.p;
         da_.tri_uv = tri_uv_.p; da_.tri_tex = tri_tex_.p; da_.texels = texels_.p; da_.tex_info = tex_info_.p;
@@ -173,9 +171,7 @@ public:
         da_.enc = a.encoding;
         NBVH_CHECK_SIZE(!a.part_roots.empty() && a.part_boxes.size() == 6 * a.part_roots.size());
         part_boxes_.upload(a.part_boxes);
-        part_roots_.upload(a.part_roots);
         da_.part_boxes = part_boxes_.p;
-        da_.part_roots = part_roots_.p;
         da_.parts = uint32_t(a.part_roots.size());
         da_.min_exit = a.min_exit;
 
@@ -218,18 +214,20 @@ public:
         // sampling may still read the buffers freed below.
         NBVH_CUDA_CHECK(cudaStreamSynchronize(side_));
         cut_gen_++;
-        cuts_.clear();
-        for (size_t k = 0; k < cuts.size(); ++k) {
-            cuts_.push_back(std::make_unique<DevBuf<int32_t>>());
-            cuts_.back()->upload(cuts[k].leaf_of_base_node);
-        }
+        std::vector<CutNode> nodes;
+        std::vector<uint32_t> roots;
+        for (const CoreCut& c : cuts)
+            append_cut_tree(base_boxes_, base_children_, c.leaf_of_base_node, part_roots_, nodes, roots);
+        cut_nodes_.upload(nodes);
+        cut_roots_.upload(roots);
+        cut_count_ = uint32_t(cuts.size());
         leaves_ = cuts[0].leaves;
         leaf_samples_.alloc(leaves_);
         leaf_loss_fx_.alloc(leaves_);
     }
 
     void step(const CoreStepIn& in, CoreStepOut& out) override {
-        NBVH_CHECK_SIZE(!cuts_.empty() && in.keep_probability && in.keep_probability->size() == leaves_);
+        NBVH_CHECK_SIZE(cut_count_ > 0 && in.keep_probability && in.keep_probability->size() == leaves_);
         const uint32_t n = in.batch;
         ensure_network_batch(n);
         cudaStream_t s = stream_;
@@ -421,8 +419,9 @@ private:
         b.scalars.zero_async(4, st);
         b.leaf_draws.zero_async(leaves_, st);
         DevCuts dc{};
-        dc.count = uint32_t(cuts_.size());
-        for (size_t k = 0; k < cuts_.size(); ++k) dc.leaf_of[k] = cuts_[k]->p;
+        dc.count = cut_count_;
+        dc.nodes = cut_nodes_.p;
+        dc.roots = cut_roots_.p;
         dc.keep = b.keep.p;
         dc.leaf_draws = b.leaf_draws.p;
         if (st == stream_) record(0);
@@ -450,17 +449,20 @@ private:
     int last_slot_ = 0;
     uint64_t cut_gen_ = 0;
     uint32_t grid_n_ = 0, leaves_ = 0;
-    DevBuf<float> node_boxes_, tri_v_, tri_n_, tri_a_, tri_g_, part_boxes_, tri_uv_, srgb_;
-    DevBuf<uint32_t> part_roots_, texels_, tex_info_;
+    std::vector<float> base_boxes_;                   // host: 6 per base node
+    std::vector<uint32_t> base_children_, part_roots_; // host: 2 per base node; base root per part
+    DevBuf<CutNode> cut_nodes_;                       // every cut's compact tree (cut_tree.h)
+    DevBuf<uint32_t> cut_roots_;                      // [cut * parts + part]
+    uint32_t cut_count_ = 0;
+    DevBuf<float> tri_v_, tri_n_, tri_a_, tri_g_, part_boxes_, tri_uv_, srgb_;
+    DevBuf<uint32_t> texels_, tex_info_;
     DevBuf<int32_t> tri_tex_;
-    DevBuf<uint2> children_;
     DevBuf<GpuBvhNode> mesh_nodes_;
     DevBuf<float> grid_w_, grid_m_, grid_v_, grid_grad_, mlp_w_, mlp_m_, mlp_v_, mlp_grad_, slices_;
     DevBuf<uint32_t> grid_t_, mlp_t_, leaf_samples_, flag_;
     DevBuf<__half> grid_h_, mlp_h_, b_feat_;
     DevBuf<unsigned long long> grid_grad_fx_, leaf_loss_fx_;
     DevBuf<double> partials_;
-    std::vector<std::unique_ptr<DevBuf<int32_t>>> cuts_;
     DevBuf<float> b_dfeat_, b_loss_; // features (b_feat_ above), dL/dfeature and losses: network part only
 };
 

@@ -1,5 +1,5 @@
-// Shared by the .cu files of the CUDA trainer: error checks, device PCG32 (bit-identical to
-// trainer/training_rays.h Pcg32) and the device-side views of the uploaded asset and batch.
+// Shared by the .cu files of the CUDA trainer: error checks (PCG32: trainer/pcg32.h, one definition
+// with the CPU) and the device-side views of the uploaded asset and batch.
 #pragma once
 #include <cuda_fp16.h>
 #include <cuda_runtime.h>
@@ -14,6 +14,8 @@
 #include "shaders/shared/mlp.h"
 #include "shaders/shared/neural_query.h"
 #include "engine/neural/shared/training_loss.h"
+#include "trainer/cuda/cut_tree.h"
+#include "trainer/pcg32.h"
 
 #define NBVH_CUDA_CHECK(expr)                                                                          \
     do {                                                                                               \
@@ -25,28 +27,7 @@
 
 namespace nbvh::cuda {
 
-// Same generator and stream split as the CPU (training_rays.h), so both backends can draw the same rays.
-struct DevPcg32 {
-    uint64_t state, inc;
-    __device__ DevPcg32(uint64_t seed, uint64_t stream) : state(0), inc((stream << 1u) | 1u) {
-        next_u32();
-        state += seed;
-        next_u32();
-    }
-    __device__ uint32_t next_u32() {
-        const uint64_t old = state;
-        state = old * 6364136223846793005ull + inc;
-        const uint32_t xorshifted = uint32_t(((old >> 18u) ^ old) >> 27u);
-        const uint32_t rot = uint32_t(old >> 59u);
-        return (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
-    }
-    __device__ float next_float() { return float(next_u32() >> 8) * (1.0f / 16777216.0f); }
-};
-
 struct DevAsset {
-    const float* node_boxes = nullptr;   // 6 per base node
-    const uint2* children = nullptr;     // per base node
-    uint32_t base_nodes = 0;
     const GpuBvhNode* mesh_nodes = nullptr;
     const float* tri_v = nullptr;        // 9 per triangle
     const float* tri_n = nullptr;        // 9 per triangle
@@ -59,14 +40,14 @@ struct DevAsset {
     const float* tri_g = nullptr;        // 3 per triangle
     GpuEncodingBox enc;
     const float* part_boxes = nullptr;    // 6 per part: sampling box lo xyz, extent xyz
-    const uint32_t* part_roots = nullptr; // base-BVH root per part
     uint32_t parts = 1;
     float min_exit = 0.0f;
 };
 
 #define NB_CUDA_MAX_CUTS 8
 struct DevCuts {
-    const int32_t* leaf_of[NB_CUDA_MAX_CUTS];
+    const CutNode* nodes = nullptr;      // every cut's compact tree (cut_tree.h)
+    const uint32_t* roots = nullptr;     // [cut * parts + part]: the part's root in `nodes` (kCutNone: empty)
     uint32_t count = 0;
     const float* keep = nullptr;         // cuts[0] keep probability per leaf
     uint32_t* leaf_draws = nullptr;      // cuts[0] draws per leaf (atomics)

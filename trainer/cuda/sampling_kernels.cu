@@ -11,17 +11,30 @@ namespace {
 
 struct Found { int32_t leaf; float t_entry, t_exit; };
 
-// first_leaf_of_cut: nearest-first descent of the base BVH, stopping at cut leaves.
-__device__ Found first_leaf(const DevAsset& a, const int32_t* leaf_of, vec3 o, vec3 d, float dilation, uint32_t root) {
+// A node of a cut tree through the read-only cache: box and children (cut_tree.h).
+struct LoadedNode {
+    float lo[3], hi[3];
+    uint32_t left, right;
+};
+__device__ inline LoadedNode load_node(const CutNode* nodes, uint32_t i) {
+    const float4* p = reinterpret_cast<const float4*>(nodes + i);
+    const float4 a = __ldg(p), b = __ldg(p + 1);
+    return LoadedNode{{a.x, a.y, a.z}, {a.w, b.x, b.y}, __float_as_uint(b.z), __float_as_uint(b.w)};
+}
+
+// first_leaf_of_cut (trainer/training_rays.cpp): nearest-first descent from a part's root, stopping at
+// cut leaves, on the cut's compact tree. Same nodes in the same order as the CPU's walk of the base BVH.
+__device__ Found first_leaf(const CutNode* nodes, uint32_t root, vec3 o, vec3 d, float dilation, float min_exit) {
     Found best{-1, 0.0f, 0.0f};
+    if (root == kCutNone) return best; // empty base BVH
     const InvDir id = inv_dir(d);
     float best_entry = NB_INF;
     uint32_t st_node[NB_BVH_MAX_DEPTH * 2 + 2];
     float st_t[NB_BVH_MAX_DEPTH * 2 + 2];
     int top = 0;
     float t0, t1;
-    if (a.base_nodes == 0) return best;
-    if (!clip_dilated(a.node_boxes + size_t(root) * 6, o, d, id, dilation, t0, t1) || t1 <= a.min_exit) return best;
+    LoadedNode n = load_node(nodes, root);
+    if (!clip_dilated(n.lo, n.hi, o, d, id, dilation, t0, t1) || t1 <= min_exit) return best;
     st_node[top] = root;
     st_t[top++] = t0;
     while (top > 0) {
@@ -29,31 +42,30 @@ __device__ Found first_leaf(const DevAsset& a, const int32_t* leaf_of, vec3 o, v
         const uint32_t node = st_node[top];
         const float te = st_t[top];
         if (te >= best_entry) continue;
-        const int32_t slot = leaf_of[node];
-        if (slot >= 0) {
+        n = load_node(nodes, node);
+        if (n.right == kCutLeafTag) {
             float ea = 0.0f, eb = 0.0f;
-            clip_dilated(a.node_boxes + size_t(node) * 6, o, d, id, dilation, ea, eb);
-            best = Found{slot, ea, eb};
+            clip_dilated(n.lo, n.hi, o, d, id, dilation, ea, eb);
+            best = Found{int32_t(n.left), ea, eb};
             best_entry = te;
             continue;
         }
-        const uint2 ch = a.children[node];
-        if (ch.x == 0xFFFFFFFFu && ch.y == 0xFFFFFFFFu) continue; // base leaf below no cut leaf
+        if (n.left == kCutNone && n.right == kCutNone) continue; // base leaf below no cut leaf
         uint32_t kn[2];
         float kt[2];
         int count = 0;
-        const uint32_t kids[2] = {ch.x, ch.y};
+        const uint32_t kids[2] = {n.left, n.right};
         for (int k = 0; k < 2; ++k) {
             const uint32_t child = kids[k];
-            if (child == 0xFFFFFFFFu) continue;
-            if (clip_dilated(a.node_boxes + size_t(child) * 6, o, d, id, dilation, t0, t1) && t1 > a.min_exit &&
-                t0 < best_entry) {
+            if (child == kCutNone) continue;
+            const LoadedNode c = load_node(nodes, child);
+            if (clip_dilated(c.lo, c.hi, o, d, id, dilation, t0, t1) && t1 > min_exit && t0 < best_entry) {
                 kn[count] = child;
                 kt[count++] = t0;
             }
         }
         if (count == 2 && kt[0] < kt[1]) {
-            const uint32_t n = kn[0]; kn[0] = kn[1]; kn[1] = n;
+            const uint32_t m = kn[0]; kn[0] = kn[1]; kn[1] = m;
             const float t = kt[0]; kt[0] = kt[1]; kt[1] = t;
         }
         if (top + count > int(NB_BVH_MAX_DEPTH * 2 + 2)) return best; // cannot happen for a valid BVH
@@ -65,54 +77,121 @@ __device__ Found first_leaf(const DevAsset& a, const int32_t* leaf_of, vec3 o, v
     return best;
 }
 
-__global__ void k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint64_t seed, uint32_t step,
-                         unsigned long long* draws_total, uint32_t* valid_total) {
-    const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= batch) return;
-    DevPcg32 rng(seed ^ (uint64_t(step) * 0x9E3779B97F4A7C15ull), i);
-    uint32_t draws = 0;
-    int32_t leaf = -1;
-    uint32_t cut = 0;
-    vec3 so(0.0f), sd(0.0f);
-    float len = 0.0f;
-    const uint32_t max_draws = 100000u;
-    for (uint32_t attempt = 0; attempt < max_draws; ++attempt) {
-        draws++;
-        const uint32_t ci = c.count > 1 ? min(uint32_t(rng.next_float() * float(c.count)), c.count - 1u) : 0u;
-        // The part (trainer/training_asset.h pick_part; drawn only when there are several).
-        const uint32_t pi = a.parts > 1 ? min(uint32_t(rng.next_float() * float(a.parts)), a.parts - 1u) : 0u;
-        const float* pb = a.part_boxes + size_t(pi) * 6;
-        // The CPU evaluates glm::vec3(f(), f(), f()) and uniform_sphere_direction(f(), f()) arguments
-        // right to left (g++): z first, then y, then x; u2 before u1.
-        const float rz = rng.next_float(), ry = rng.next_float(), rx = rng.next_float();
-        const vec3 o(pb[0] + pb[3] * rx, pb[1] + pb[4] * ry, pb[2] + pb[5] * rz);
-        const float u2 = rng.next_float(), u1 = rng.next_float();
-        const float phi = 2.0f * 3.14159265358979323846f * u1;
-        const float cos_theta = 2.0f * u2 - 1.0f;
-        const float sin_theta = sqrtf(fmaxf(0.0f, 1.0f - cos_theta * cos_theta));
-        const vec3 d(sin_theta * cosf(phi), sin_theta * sinf(phi), cos_theta);
-        const float dilation = 1e-5f + 1e-4f * rng.next_float();
-        const Found f = first_leaf(a, c.leaf_of[ci], o, d, dilation, a.part_roots[pi]);
-        if (f.leaf < 0) continue;
-        if (ci == 0) {
-            atomicAdd(&c.leaf_draws[f.leaf], 1u);
-            const float keep = c.keep[f.leaf];
-            if (keep < 1.0f && rng.next_float() >= keep) continue;
-        }
-        so = o + d * f.t_entry;
-        sd = d;
-        len = fmaxf(f.t_exit - f.t_entry, 0.0f);
-        leaf = f.leaf;
-        cut = ci;
-        break;
+// One attempt of a slot: the body of the CPU loop (cpu_backend.cpp draw_training_sample), on the
+// attempt's own stream (trainer/pcg32.h SampleSlot).
+struct Attempt {
+    Found f;
+    uint32_t cut;
+    bool kept;
+    vec3 o, d;
+};
+
+__device__ Attempt try_attempt(const DevAsset& a, const DevCuts& c, const SampleSlot& where, uint32_t attempt) {
+    Pcg32 rng = where.attempt_rng(attempt);
+    Attempt r;
+    r.cut = c.count > 1 ? min(uint32_t(rng.next_float() * float(c.count)), c.count - 1u) : 0u;
+    // The part (trainer/training_asset.h pick_part; drawn only when there are several).
+    const uint32_t pi = a.parts > 1 ? min(uint32_t(rng.next_float() * float(a.parts)), a.parts - 1u) : 0u;
+    const float* pb = a.part_boxes + size_t(pi) * 6;
+    // The CPU evaluates glm::vec3(f(), f(), f()) and uniform_sphere_direction(f(), f()) arguments
+    // right to left (g++): z first, then y, then x; u2 before u1.
+    const float rz = rng.next_float(), ry = rng.next_float(), rx = rng.next_float();
+    r.o = vec3(pb[0] + pb[3] * rx, pb[1] + pb[4] * ry, pb[2] + pb[5] * rz);
+    const float u2 = rng.next_float(), u1 = rng.next_float();
+    const float phi = 2.0f * 3.14159265358979323846f * u1;
+    const float cos_theta = 2.0f * u2 - 1.0f;
+    const float sin_theta = sqrtf(fmaxf(0.0f, 1.0f - cos_theta * cos_theta));
+    r.d = vec3(sin_theta * cosf(phi), sin_theta * sinf(phi), cos_theta);
+    const float dilation = 1e-5f + 1e-4f * rng.next_float();
+    r.f = first_leaf(c.nodes, c.roots[r.cut * a.parts + pi], r.o, r.d, dilation, a.min_exit);
+    r.kept = r.f.leaf >= 0;
+    if (r.kept && r.cut == 0) {
+        const float keep = c.keep[r.f.leaf];
+        r.kept = !(keep < 1.0f && rng.next_float() >= keep);
     }
+    return r;
+}
+
+__device__ void write_sample(const DevBatch& b, uint32_t i, vec3 so, vec3 sd, float len, int32_t leaf, uint32_t cut) {
     b.origin[3 * i] = so.x; b.origin[3 * i + 1] = so.y; b.origin[3 * i + 2] = so.z;
     b.dir[3 * i] = sd.x; b.dir[3 * i + 1] = sd.y; b.dir[3 * i + 2] = sd.z;
     b.length[i] = len;
     b.leaf[i] = leaf;
     b.cut[i] = cut;
-    atomicAdd(draws_total, (unsigned long long)draws);
-    if (leaf >= 0) atomicAdd(valid_total, 1u);
+}
+
+// Lanes l in [0, 32) with l % n == r.
+__device__ uint32_t lanes_of_rank(uint32_t r, uint32_t n) {
+    uint32_t m = 0u;
+    for (uint32_t l = r; l < 32u; l += n) m |= 1u << l;
+    return m;
+}
+
+// Position of the (k+1)-th set bit of m (m has more than k set bits).
+__device__ uint32_t nth_set_bit(uint32_t m, uint32_t k) {
+    for (uint32_t j = 0; j < k; ++j) m &= m - 1u;
+    return uint32_t(__ffs(int(m)) - 1);
+}
+
+constexpr uint32_t kFullWarp = 0xFFFFFFFFu;
+constexpr uint32_t kMaxDraws = 100000u; // cpu_backend.h draw_training_sample's default
+
+// Each lane owns one slot; a warp resolves its 32 slots together. Per round the n slots still open
+// share the 32 lanes (lane l tries attempt next[slot] + l / n of the (l % n)-th open slot), so a slot
+// that needs many redraws gets the lanes of the slots already done instead of leaving them idle (the
+// per-slot loop this replaces cost a warp its slowest slot's redraw count). A slot's sample is its
+// first kept attempt and only attempts up to it count as draws: the CPU loop's result, bit for bit.
+__global__ void k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint64_t seed, uint32_t step,
+                         unsigned long long* draws_total, uint32_t* valid_total) {
+    const uint32_t lane = threadIdx.x & 31u;
+    const uint32_t slot = blockIdx.x * blockDim.x + threadIdx.x;
+    const uint32_t warp_base = slot - lane;
+    bool open = slot < batch; // as the owner of `slot`
+    uint32_t next = 0;        // as the owner: attempts taken so far
+    uint32_t drawn = 0, valid = 0;
+    for (;;) {
+        const uint32_t open_mask = __ballot_sync(kFullWarp, open);
+        if (open_mask == 0u) break;
+        const uint32_t n = uint32_t(__popc(open_mask));
+        // As an attempter: which slot, which attempt.
+        const uint32_t rank = lane % n;
+        const uint32_t owner = nth_set_bit(open_mask, rank);
+        const uint32_t attempt = __shfl_sync(kFullWarp, next, owner) + lane / n;
+        const bool active = attempt < kMaxDraws;
+        Attempt r{};
+        if (active) r = try_attempt(a, c, SampleSlot{seed, step, warp_base + owner}, attempt);
+        const bool success = active && r.kept;
+        const uint32_t wins = __ballot_sync(kFullWarp, success);
+        const uint32_t mine = wins & lanes_of_rank(rank, n);
+        const uint32_t first = mine ? uint32_t(__ffs(int(mine)) - 1) : 32u;
+        if (active && lane <= first) { // attempts up to the slot's first kept one count
+            drawn++;
+            if (r.cut == 0u && r.f.leaf >= 0) atomicAdd(&c.leaf_draws[r.f.leaf], 1u);
+        }
+        if (success && lane == first)
+            write_sample(b, warp_base + owner, r.o + r.d * r.f.t_entry, r.d, fmaxf(r.f.t_exit - r.f.t_entry, 0.0f),
+                         r.f.leaf, r.cut);
+        if (open) { // as the owner: done, or the attempts this round took
+            const uint32_t my_rank = uint32_t(__popc(open_mask & ((1u << lane) - 1u)));
+            const uint32_t lanes = lanes_of_rank(my_rank, n);
+            if (wins & lanes) {
+                open = false;
+                valid++;
+            } else {
+                next += uint32_t(__popc(lanes));
+                if (next >= kMaxDraws) { // starved: no reachable leaf
+                    open = false;
+                    write_sample(b, slot, vec3(0.0f), vec3(0.0f), 0.0f, -1, 0u);
+                }
+            }
+        }
+    }
+    drawn = __reduce_add_sync(kFullWarp, drawn);
+    valid = __reduce_add_sync(kFullWarp, valid);
+    if (lane == 0u) {
+        atomicAdd(draws_total, (unsigned long long)drawn);
+        if (valid) atomicAdd(valid_total, valid);
+    }
 }
 
 __device__ vec3 load3(const float* p) { return vec3(p[0], p[1], p[2]); }
@@ -235,6 +314,7 @@ __global__ void k_ground_truth(DevAsset a, DevBatch b) {
 
 void launch_sample(const DevAsset& a, const DevCuts& c, const DevBatch& b, uint32_t batch, uint64_t seed,
                    uint32_t step, unsigned long long* draws, uint32_t* valid, cudaStream_t s) {
+    // Whole warps: k_sample's lanes cooperate (slots past the batch start resolved).
     k_sample<<<(batch + 127) / 128, 128, 0, s>>>(a, c, b, batch, seed, step, draws, valid);
     NBVH_CUDA_CHECK(cudaGetLastError());
 }

@@ -1,0 +1,33 @@
+// The GPU sampler's view of an N-BVH cut (sampling_kernels.cu first_leaf): the base-BVH nodes above and
+// at the cut's leaves, copied into one compact array in depth-first order with their boxes, so the
+// first-leaf search of every training ray reads a few contiguous, cache-resident nodes instead of three
+// scattered arrays over the whole base BVH (1.1 M nodes for the dragon). Built on the host (cuda_core.cu
+// set_cuts) whenever the cut changes; the search over it visits the same nodes in the same order as the
+// CPU's first_leaf_of_cut (trainer/training_rays.cpp), so both draw the same rays.
+// Host code (g++ and nvcc): plain arrays only.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+namespace nbvh::cuda {
+
+inline constexpr uint32_t kCutNone = 0xFFFFFFFFu;     // no child / no node
+inline constexpr uint32_t kCutLeafTag = 0xFFFFFFFEu;  // `right` of a cut leaf; `left` holds its slot
+
+// 32 bytes, read as two 16-byte loads: box (lo xyz, hi xyz) and the two children's compact indices
+// (kCutNone where absent; a base leaf below no cut leaf has none). A cut leaf: left = leaf slot,
+// right = kCutLeafTag.
+struct alignas(16) CutNode {
+    float lo[3], hi[3];
+    uint32_t left, right;
+};
+static_assert(sizeof(CutNode) == 32, "CutNode is two 16-byte loads");
+
+// Appends the compact tree of one cut to `nodes` and one root per part to `roots` (compact index, or
+// kCutNone for an empty base BVH). `boxes`: 6 floats per base node; `children`: 2 per base node
+// (kCutNone for none); `leaf_of_base_node`: the cut's slot per base node or -1.
+void append_cut_tree(const std::vector<float>& boxes, const std::vector<uint32_t>& children,
+                     const std::vector<int32_t>& leaf_of_base_node, const std::vector<uint32_t>& part_roots,
+                     std::vector<CutNode>& nodes, std::vector<uint32_t>& roots);
+
+} // namespace nbvh::cuda
