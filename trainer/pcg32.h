@@ -4,10 +4,12 @@
 #pragma once
 #include <cstdint>
 
+#ifndef NBVH_HOST_DEVICE
 #if defined(__CUDACC__)
 #define NBVH_HOST_DEVICE __host__ __device__
 #else
 #define NBVH_HOST_DEVICE
+#endif
 #endif
 
 namespace nbvh {
@@ -52,6 +54,10 @@ NBVH_HOST_DEVICE inline uint64_t mix64(uint64_t z) {
 // over 40,000 slots, tests/trainer/sample_streams_test.cpp), and PCG streams that share a start state
 // and differ only in their increment are related too. (Until 2026-11: one stream per slot, attempts in
 // sequence.)
+// Attempts a slot makes before it gives up (leaf -1, not trained), so a cut that rays cannot reach never
+// hangs training. Both backends stop at the same attempt.
+inline constexpr uint32_t kMaxSampleAttempts = 100000u;
+
 struct SampleSlot {
     uint64_t seed = 0;
     uint32_t step = 0;

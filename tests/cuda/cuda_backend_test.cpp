@@ -5,6 +5,7 @@
 // non-finite guard. Every test skips without a usable CUDA GPU.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <numeric>
@@ -44,19 +45,20 @@ double rel_l2(const std::vector<float>& a, const std::vector<double>& b) {
 // with per-hit texture lookups).
 // Also the draw counts: the GPU spreads a slot's attempts over its warp's idle lanes (sampling_kernels.cu
 // k_sample) and must count exactly the attempts up to the first kept one, per leaf and in total.
-uint32_t check_rays_and_truth(const TrainingAsset& asset, const TrainingCut& cut, const StepParams& p,
-                              const StepStats& st, const std::vector<CudaDebugSample>& samples) {
+// The cuts are p.cuts (several: levels of detail, one picked per attempt; draws counted for cuts[0] only).
+uint32_t check_rays_and_truth(const TrainingAsset& asset, const StepParams& p, const StepStats& st,
+                              const std::vector<CudaDebugSample>& samples) {
     uint32_t same = 0;
     uint64_t draws = 0;
-    std::vector<uint32_t> leaf_draws(cut.size(), 0u);
+    std::vector<uint32_t> leaf_draws(p.cuts[0]->size(), 0u);
     for (uint32_t i = 0; i < p.batch_size; ++i) {
-        const std::vector<const TrainingCut*> cuts{&cut};
-        const TrainingSample s = draw_training_sample(asset, cuts, {p.seed, p.step, i}, leaf_draws.data(), draws);
-        if (s.leaf == samples[i].leaf && glm::length(s.origin - samples[i].origin) <= 1e-4f * glm::length(asset.bounds.extent()))
+        const TrainingSample s = draw_training_sample(asset, p.cuts, {p.seed, p.step, i}, leaf_draws.data(), draws);
+        if (s.leaf == samples[i].leaf && s.cut == samples[i].cut &&
+            glm::length(s.origin - samples[i].origin) <= 1e-4f * glm::length(asset.bounds.extent()))
             same++;
     }
     EXPECT_GE(same, p.batch_size * 99 / 100);
-    EXPECT_GT(draws, uint64_t(p.batch_size)); // the roulette (keep 0.5 on a third of the leaves) redraws
+    EXPECT_GT(draws, uint64_t(p.batch_size)); // misses and the roulette's rejections are redrawn
     // A ray moved by sin/cos rounding changes a few counts; the attempts themselves must line up.
     EXPECT_NEAR(double(st.draws), double(draws), 0.002 * double(draws));
     EXPECT_EQ(st.leaves.size(), leaf_draws.size());
@@ -111,7 +113,7 @@ void check_against_cpu(bool deterministic, uint32_t batch) {
     std::vector<float> mlp_grad, grid_grad;
     gpu->read_last_step(samples, mlp_grad, grid_grad);
 
-    const uint32_t same = check_rays_and_truth(asset, cut, p, st, samples);
+    const uint32_t same = check_rays_and_truth(asset, p, st, samples);
 
     // 3. Loss and gradients: CPU reference network (fp16-emulated forward = the shaders' rounding) on the
     //    GPU's samples and targets, with the initial weights (same init for the seed).
@@ -298,20 +300,64 @@ TEST(CudaBackend, MultiAssetTexturedTruthMatchesCpu) {
     }
     const TrainingAsset asset = make_training_asset(s, neural_meshes(s));
     ASSERT_EQ(asset.parts.size(), 3u);
-    TrainingCut cut = cut_at_depth(asset, 5);
+    // Two levels of detail (each attempt picks one; only the finer one's draws are counted) and a
+    // roulette on some of the finer cut's leaves.
+    TrainingCut cut = cut_at_depth(asset, 5), coarse = cut_at_depth(asset, 2);
+    for (size_t i = 0; i < cut.size(); ++i) cut.keep_probability[i] = i % 4 == 1 ? 0.3f : 1.0f;
     auto gpu = make_cuda_backend_ex(asset, NeuralConfig{.log2_hash_size = 14}, neural::AdamConfig{}, CudaBackendOptions{}, 7);
     StepParams p;
     p.step = 1;
     p.batch_size = 4096;
     p.seed = 5;
-    p.cuts = {&cut};
+    p.cuts = {&cut, &coarse};
     p.cut_version = 1;
     const StepStats st = gpu->step(p);
     ASSERT_FALSE(st.skipped) << st.skip_reason;
     std::vector<CudaDebugSample> samples;
     std::vector<float> mlp_grad, grid_grad;
     gpu->read_last_step(samples, mlp_grad, grid_grad);
-    check_rays_and_truth(asset, cut, p, st, samples);
+    uint32_t on_coarse = 0;
+    for (const CudaDebugSample& x : samples) on_coarse += x.cut == 1u ? 1u : 0u;
+    EXPECT_GT(on_coarse, p.batch_size / 4); // both cuts are sampled
+    check_rays_and_truth(asset, p, st, samples);
+}
+
+// A cut whose every leaf is rejected: each slot (an odd batch, so the last warp is partial and the
+// rounds end with idle lanes) makes exactly kMaxSampleAttempts attempts and is not trained, as on the CPU.
+TEST(CudaBackend, UnreachableCutStarvesEverySlotAfterTheSameAttempts) {
+    REQUIRE_GPU();
+    const Scene scene = test::scene_of(test::cube(1.0f));
+    const TrainingAsset asset = make_training_asset(scene, 0);
+    TrainingCut cut = cut_at_depth(asset, 2);
+    std::fill(cut.keep_probability.begin(), cut.keep_probability.end(), 0.0f);
+    auto gpu = make_cuda_backend_ex(asset, NeuralConfig{.log2_hash_size = 14}, neural::AdamConfig{}, CudaBackendOptions{}, 7);
+    StepParams p;
+    p.step = 2;
+    p.batch_size = 37;
+    p.seed = 9;
+    p.cuts = {&cut};
+    p.cut_version = 1;
+    const StepStats st = gpu->step(p);
+    EXPECT_EQ(st.samples, 0u);
+    EXPECT_EQ(st.draws, uint64_t(p.batch_size) * kMaxSampleAttempts);
+    std::vector<CudaDebugSample> samples;
+    std::vector<float> mlp_grad, grid_grad;
+    gpu->read_last_step(samples, mlp_grad, grid_grad);
+    ASSERT_EQ(samples.size(), p.batch_size);
+    for (const CudaDebugSample& x : samples) EXPECT_EQ(x.leaf, -1);
+    uint64_t cpu_draws = 0;
+    std::vector<uint32_t> cpu_leaf_draws(cut.size(), 0u);
+    for (uint32_t i = 0; i < p.batch_size; ++i)
+        EXPECT_EQ(draw_training_sample(asset, p.cuts, {p.seed, p.step, i}, cpu_leaf_draws.data(), cpu_draws).leaf, -1);
+    EXPECT_EQ(cpu_draws, st.draws);
+    ASSERT_EQ(st.leaves.size(), cut.size());
+    uint64_t off = 0, total = 0;
+    for (size_t l = 0; l < cut.size(); ++l) {
+        off += uint64_t(std::llabs(int64_t(st.leaves[l].draws) - int64_t(cpu_leaf_draws[l])));
+        total += cpu_leaf_draws[l];
+    }
+    EXPECT_GT(total, 0u);
+    EXPECT_LE(off, total / 200);
 }
 
 } // namespace nbvh

@@ -1,5 +1,5 @@
 // The compact cut tree of the CUDA sampler (trainer/cuda/cut_tree.h): host code, so these run without a
-// GPU too. The GPU sampler over it is checked against the CPU's first_leaf_of_cut in cuda_backend_test.cpp.
+// GPU too (built where CUDA is, as part of nbvh_cuda_tests; CI builds them). The GPU sampler over it is checked against the CPU's first_leaf_of_cut in cuda_backend_test.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -116,6 +116,33 @@ TEST(CutTree, SeveralCutsAndPartsAppendWithTheirOwnRoots) {
     }
     EXPECT_EQ(seen_fine.size(), fine.size());
     EXPECT_EQ(seen_coarse.size(), coarse.size());
+}
+
+TEST(CutTree, OneChildNodesAndBaseLeavesBelowNoCutLeaf) {
+    // Base: 0 -> (1, none); 1 -> (2, 3); 2 and 3 are base leaves; the cut holds only node 2, so node 3 is
+    // a base leaf below no cut leaf (the sampler's walk skips it: no children, no slot).
+    std::vector<float> boxes;
+    for (int i = 0; i < 4; ++i)
+        for (float v : {float(-i), 0.0f, 0.0f, float(i) + 1.0f, 1.0f, 1.0f}) boxes.push_back(v);
+    const std::vector<uint32_t> children{1, kCutNone, 2, 3, kCutNone, kCutNone, kCutNone, kCutNone};
+    const std::vector<int32_t> leaf_of{-1, -1, 0, -1};
+    std::vector<CutNode> nodes;
+    std::vector<uint32_t> roots;
+    cuda::append_cut_tree(boxes, children, leaf_of, {0}, nodes, roots);
+    ASSERT_EQ(nodes.size(), 4u);
+    EXPECT_EQ(roots, (std::vector<uint32_t>{0u}));
+    EXPECT_EQ(nodes[0].left, 1u);
+    EXPECT_EQ(nodes[0].right, kCutNone);
+    EXPECT_EQ(nodes[1].left, 2u);
+    EXPECT_EQ(nodes[1].right, 3u);
+    EXPECT_EQ(nodes[2].left, 0u); // slot 0
+    EXPECT_EQ(nodes[2].right, kCutLeafTag);
+    EXPECT_EQ(nodes[3].left, kCutNone);
+    EXPECT_EQ(nodes[3].right, kCutNone);
+    for (uint32_t i = 0; i < 4; ++i) {
+        EXPECT_EQ(nodes[i].lo[0], -float(i));
+        EXPECT_EQ(nodes[i].hi[0], float(i) + 1.0f);
+    }
 }
 
 TEST(CutTree, RejectsInconsistentInput) {

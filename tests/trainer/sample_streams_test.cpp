@@ -7,6 +7,7 @@
 #include <cmath>
 #include <vector>
 
+#include "tests/trainer/test_cuts.h"
 #include "tests/trainer/trainer_test_scenes.h"
 #include "trainer/cpu/cpu_backend.h"
 #include "trainer/training_asset.h"
@@ -14,23 +15,7 @@
 namespace nbvh {
 namespace {
 
-TrainingCut cut_at_depth(const TrainingAsset& a, uint32_t depth) {
-    std::vector<uint32_t> leaves, stack{0};
-    while (!stack.empty()) {
-        const uint32_t n = stack.back();
-        stack.pop_back();
-        const BvhNode& node = a.bvh().nodes[n];
-        if (node.is_leaf() || node.depth >= depth) {
-            leaves.push_back(n);
-            continue;
-        }
-        stack.push_back(node.left);
-        stack.push_back(node.right);
-    }
-    TrainingCut c;
-    c.assign(leaves, a.bvh().nodes.size());
-    return c;
-}
+using test::cut_at_depth;
 
 double pearson(const std::vector<double>& x, const std::vector<double>& y) {
     double mx = 0, my = 0;

@@ -31,6 +31,6 @@ struct TrainingSample {
 // Attempt k draws its random numbers from where.attempt_rng(k) (trainer/pcg32.h).
 TrainingSample draw_training_sample(const TrainingAsset& asset, std::span<const TrainingCut* const> cuts,
                                     const SampleSlot& where, uint32_t* leaf_draws, uint64_t& draws,
-                                    uint32_t max_draws = 100000);
+                                    uint32_t max_draws = kMaxSampleAttempts);
 
 } // namespace nbvh

@@ -15,10 +15,11 @@
 
 namespace nbvh::cuda {
 
-// Everything about the asset the GPU needs, in flat host arrays (uploaded once).
+// Everything about the asset the GPU needs, in flat host arrays (uploaded once, except the base BVH).
 struct CoreAsset {
     // Base BVH of the N-BVH cut (CPU node order): regularised boxes (lo xyz, hi xyz) and children
-    // (left, right; 0xFFFFFFFF for none).
+    // (left, right; 0xFFFFFFFF for none). Kept on the host: each cut's compact tree is built from it
+    // (cut_tree.h) whenever the cuts change.
     std::vector<float> node_boxes;      // 6 per node
     std::vector<uint32_t> node_children; // 2 per node
     // Triangle BVH for the ground truth: GPU layout (leaf refs index triangles in leaf order).

@@ -44,6 +44,7 @@ struct DevAsset {
     float min_exit = 0.0f;
 };
 
+// Levels of detail a step may sample (a limit of the options, not an array size).
 #define NB_CUDA_MAX_CUTS 8
 struct DevCuts {
     const CutNode* nodes = nullptr;      // every cut's compact tree (cut_tree.h)

@@ -17,9 +17,9 @@ struct LoadedNode {
     uint32_t left, right;
 };
 __device__ inline LoadedNode load_node(const CutNode* nodes, uint32_t i) {
-    const float4* p = reinterpret_cast<const float4*>(nodes + i);
-    const float4 a = __ldg(p), b = __ldg(p + 1);
-    return LoadedNode{{a.x, a.y, a.z}, {a.w, b.x, b.y}, __float_as_uint(b.z), __float_as_uint(b.w)};
+    const float4 a = __ldg(reinterpret_cast<const float4*>(nodes + i));
+    const uint4 b = __ldg(reinterpret_cast<const uint4*>(nodes + i) + 1);
+    return LoadedNode{{a.x, a.y, a.z}, {a.w, __uint_as_float(b.x), __uint_as_float(b.y)}, b.z, b.w};
 }
 
 // first_leaf_of_cut (trainer/training_rays.cpp): nearest-first descent from a part's root, stopping at
@@ -134,13 +134,15 @@ __device__ uint32_t nth_set_bit(uint32_t m, uint32_t k) {
 }
 
 constexpr uint32_t kFullWarp = 0xFFFFFFFFu;
-constexpr uint32_t kMaxDraws = 100000u; // cpu_backend.h draw_training_sample's default
 
 // Each lane owns one slot; a warp resolves its 32 slots together. Per round the n slots still open
 // share the 32 lanes (lane l tries attempt next[slot] + l / n of the (l % n)-th open slot), so a slot
 // that needs many redraws gets the lanes of the slots already done instead of leaving them idle (the
 // per-slot loop this replaces cost a warp its slowest slot's redraw count). A slot's sample is its
 // first kept attempt and only attempts up to it count as draws: the CPU loop's result, bit for bit.
+constexpr uint32_t kSampleBlock = 128; // whole warps: k_sample's lanes cooperate with full-mask intrinsics
+static_assert(kSampleBlock % 32u == 0u, "k_sample needs whole warps");
+
 __global__ void k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint64_t seed, uint32_t step,
                          unsigned long long* draws_total, uint32_t* valid_total) {
     const uint32_t lane = threadIdx.x & 31u;
@@ -157,7 +159,7 @@ __global__ void k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint
         const uint32_t rank = lane % n;
         const uint32_t owner = nth_set_bit(open_mask, rank);
         const uint32_t attempt = __shfl_sync(kFullWarp, next, owner) + lane / n;
-        const bool active = attempt < kMaxDraws;
+        const bool active = attempt < kMaxSampleAttempts;
         Attempt r{};
         if (active) r = try_attempt(a, c, SampleSlot{seed, step, warp_base + owner}, attempt);
         const bool success = active && r.kept;
@@ -179,7 +181,7 @@ __global__ void k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint
                 valid++;
             } else {
                 next += uint32_t(__popc(lanes));
-                if (next >= kMaxDraws) { // starved: no reachable leaf
+                if (next >= kMaxSampleAttempts) { // starved: no reachable leaf
                     open = false;
                     write_sample(b, slot, vec3(0.0f), vec3(0.0f), 0.0f, -1, 0u);
                 }
@@ -315,7 +317,7 @@ __global__ void k_ground_truth(DevAsset a, DevBatch b) {
 void launch_sample(const DevAsset& a, const DevCuts& c, const DevBatch& b, uint32_t batch, uint64_t seed,
                    uint32_t step, unsigned long long* draws, uint32_t* valid, cudaStream_t s) {
     // Whole warps: k_sample's lanes cooperate (slots past the batch start resolved).
-    k_sample<<<(batch + 127) / 128, 128, 0, s>>>(a, c, b, batch, seed, step, draws, valid);
+    k_sample<<<(batch + kSampleBlock - 1) / kSampleBlock, kSampleBlock, 0, s>>>(a, c, b, batch, seed, step, draws, valid);
     NBVH_CUDA_CHECK(cudaGetLastError());
 }
 
