@@ -302,7 +302,7 @@ TEST(CudaBackend, MultiAssetTexturedTruthMatchesCpu) {
     ASSERT_EQ(asset.parts.size(), 3u);
     // Two levels of detail (each attempt picks one; only the finer one's draws are counted) and a
     // roulette on some of the finer cut's leaves.
-    TrainingCut cut = cut_at_depth(asset, 5), coarse = cut_at_depth(asset, 2);
+    TrainingCut cut = cut_at_depth(asset, 5), coarse = cut_at_depth(asset, 3); // part roots are at depth <= 2
     for (size_t i = 0; i < cut.size(); ++i) cut.keep_probability[i] = i % 4 == 1 ? 0.3f : 1.0f;
     auto gpu = make_cuda_backend_ex(asset, NeuralConfig{.log2_hash_size = 14}, neural::AdamConfig{}, CudaBackendOptions{}, 7);
     StepParams p;
