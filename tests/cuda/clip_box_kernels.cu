@@ -1,5 +1,5 @@
-// Kernel of clip_box_kernels.h: one thread per case, inv_dir + clip_dilated exactly as k_sample calls
-// them. Compiled with --fmad=false like sampling_kernels.cu (tests/cuda/CMakeLists.txt).
+// Kernel of clip_box_kernels.h: one thread per case, inv_dir + clip_dilated exactly as k_sample's
+// first-leaf search calls them (on a box's lo and hi). Compiled with --fmad=false like sampling_kernels.cu (tests/cuda/CMakeLists.txt).
 #include "tests/cuda/clip_box_kernels.h"
 #include "trainer/cuda/clip_box.cuh"
 
@@ -13,7 +13,9 @@ __global__ void k_clip(ClipCase* cases, const float* boxes, uint32_t n) {
     const vec3 o(c.origin[0], c.origin[1], c.origin[2]), d(c.dir[0], c.dir[1], c.dir[2]);
     const cuda::InvDir id = cuda::inv_dir(d);
     float t0 = 0.0f, t1 = 0.0f;
-    c.hit = cuda::clip_dilated(boxes + 6 * size_t(i), o, d, id, c.dilation, t0, t1) ? 1u : 0u;
+    const float* b = boxes + 6 * size_t(i);
+    const float lo[3] = {b[0], b[1], b[2]}, hi[3] = {b[3], b[4], b[5]}; // a cut node's box (cut_tree.h)
+    c.hit = cuda::clip_dilated(lo, hi, o, d, id, c.dilation, t0, t1) ? 1u : 0u;
     c.t_entry = c.hit ? t0 : 0.0f;
     c.t_exit = c.hit ? t1 : 0.0f;
 }

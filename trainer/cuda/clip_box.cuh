@@ -46,14 +46,4 @@ __device__ inline bool clip_dilated(const float lo3[3], const float hi3[3], vec3
     return true;
 }
 
-// The same on a box stored as 6 floats (lo xyz, hi xyz; 8-byte aligned), read as three float2 through
-// the read-only cache.
-__device__ inline bool clip_dilated(const float* box, vec3 o, vec3 d, const InvDir& id, float dilation, float& t_entry,
-                                    float& t_exit) {
-    const float2* b2 = reinterpret_cast<const float2*>(box);
-    const float2 p0 = __ldg(b2), p1 = __ldg(b2 + 1), p2 = __ldg(b2 + 2);
-    const float lo3[3] = {p0.x, p0.y, p1.x}, hi3[3] = {p1.y, p2.x, p2.y};
-    return clip_dilated(lo3, hi3, o, d, id, dilation, t_entry, t_exit);
-}
-
 } // namespace nbvh::cuda
