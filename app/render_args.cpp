@@ -27,11 +27,6 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
                     "leaf rounds through the batched query pass before the per-ray tail pass");
     cmd->add_option("--neural-leaves-per-round", o.neural.leaves_per_round,
                     "neural leaves a ray queues per traversal round (speculative ones included; same image)");
-    cmd->add_option_function<std::string>(
-           "--neural-sort-queries", [&o](const std::string& v) { o.neural.sort_queries = v == "on"; },
-           "evaluate each round's neural queries grouped by leaf position (on, default) or in queue order "
-           "(off); same image")
-        ->check(CLI::IsMember({"on", "off"}));
     cmd->add_option("--wave-pixels", o.max_wave_pixels,
                     "paths traced per wave (rays per queue; several samples of each pixel while they fit in 16M paths, "
                     "up to 16; also bounded by the device's buffer, memory and dispatch limits)")

@@ -33,9 +33,7 @@ std::string neural_rounds_text(const NeuralPlan& n, const char* traverse, const 
     s += strfmt("    %-26s op 0: %s, queues (ray, leaf) pairs (indirect)\n", traverse, what);
     if (n.batched_rounds > 0) {
         s += strfmt("    repeat %u x (batched rounds):\n", n.batched_rounds);
-        s += strfmt("      passes/neural_args.comp    queued pairs -> indirect dispatch arguments%s\n",
-                    n.sorted ? ", bin offsets" : "");
-        if (n.sorted) s += "      passes/neural_sort.comp    pairs in leaf-bin order (hash-grid cache locality)\n";
+        s += "      passes/neural_args.comp    queued pairs -> indirect dispatch arguments\n";
         s += strfmt("      %-26s hash grid + MLP of the queued pairs\n", n.query_shader.c_str());
         s += strfmt("      %-26s op 1: resume the queried rays, queue their next leaves\n", traverse);
     }
@@ -133,7 +131,6 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
     p.leaf_budget = stage.rounds();
     p.leaves_per_round = stage.leaves_per_round();
     p.batched_rounds = stage.batched_rounds();
-    p.sorted = stage.sorted();
     for (const Instance& inst : scene.instances) p.instances += inst.neural;
     p.assets = uint32_t(o.model->assets.size());
     return p;
@@ -147,7 +144,6 @@ void neural_rounds(std::vector<std::string>& passes, const NeuralPlan& n, const 
     passes.push_back(traverse);
     for (uint32_t r = 0; r < n.batched_rounds; ++r) {
         passes.push_back("passes/neural_args.comp");
-        if (n.sorted) passes.push_back("passes/neural_sort.comp");
         passes.push_back(n.query_shader);
         passes.push_back(traverse);
     }

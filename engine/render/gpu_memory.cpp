@@ -48,15 +48,9 @@ NeuralGpuBytes neural_gpu_bytes(const NeuralModel& model) {
 }
 
 uint64_t neural_scratch_bytes_per_ray(uint32_t leaves_per_round) {
-    // neural_stage.cpp install(): two halves of leaves_per_round pending leaves per ray, a ray state for
-    // the path ray and one for the shadow ray of each slot,
-    // and the order of one half's pending pairs (neural_sort_bytes).
-    return 2ull * leaves_per_round * sizeof(GpuPendingLeaf) + 2ull * sizeof(GpuNeuralRayState) +
-           uint64_t(leaves_per_round) * sizeof(uint32_t);
-}
-
-uint64_t neural_sort_bytes(uint32_t leaves_per_round, uint32_t capacity) {
-    return (uint64_t(NB_NL_SORT_HEADER_WORDS) + uint64_t(leaves_per_round) * std::max(capacity, 1u)) * sizeof(uint32_t);
+    // neural_stage.cpp install(): two halves of leaves_per_round pending leaves per ray, and a ray state for
+    // the path ray and one for the shadow ray of each slot.
+    return 2ull * leaves_per_round * sizeof(GpuPendingLeaf) + 2ull * sizeof(GpuNeuralRayState);
 }
 
 } // namespace nbvh::render

@@ -37,8 +37,5 @@ NeuralGpuBytes neural_gpu_bytes(const NeuralModel& model);
 // Bytes of the neural stage's per-ray working buffers per queue slot (path and shadow halves) with
 // `leaves_per_round` pending leaves per ray.
 uint64_t neural_scratch_bytes_per_ray(uint32_t leaves_per_round);
-// Bytes of the leaf-binned order's binding (shared/neural_gpu.h NB_NL_SORT_*) for `capacity` queue slots:
-// the bins of both halves, then one half's pair order.
-uint64_t neural_sort_bytes(uint32_t leaves_per_round, uint32_t capacity);
 
 } // namespace nbvh::render

@@ -8,7 +8,6 @@
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/neural/asset_table.h"
-#include "engine/render/gpu_memory.h"
 #include "shaders/shared/scene_gpu.h"
 #include "shaders/shared/wavefront_gpu.h"
 
@@ -171,7 +170,6 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     params_.metallic = o.metallic < 0.0f ? -1.0f : o.metallic;
     params_.threshold = o.threshold;
     params_.max_rounds = o.max_rounds;
-    params_.sort_queries = o.sort_queries ? 1u : 0u;
 }
 
 void NeuralStage::update(const NeuralRenderOptions& o, vk::Buffer& params_buffer) {
@@ -203,10 +201,6 @@ void NeuralStage::install(std::vector<vk::Buffer>& buffers) {
                                                vk::MemoryKind::device, 0, "neural ray state");
     buffers[NB_BIND_NEURAL_COUNTERS] =
         vk::Buffer(ctx_, sizeof(GpuNeuralCounters), vk::MemoryKind::device, 0, "neural counters");
-    // Bin counters of both halves (zero: the first traversal counts into them), then one half's order.
-    buffers[NB_BIND_NEURAL_SORT] =
-        vk::Buffer(ctx_, neural_sort_bytes(params_.leaves_per_round, capacity_), vk::MemoryKind::device, 0, "neural sort");
-    buffers[NB_BIND_NEURAL_SORT].fill(0u);
     buffers[NB_BIND_PENDING_LEAVES].fill(0u);
     buffers[NB_BIND_NEURAL_STATE].fill(0u);
     buffers[NB_BIND_NEURAL_COUNTERS].fill(0u);

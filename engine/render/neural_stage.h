@@ -57,10 +57,6 @@ struct NeuralRenderOptions {
     // scene 7.03 -> 6.62 ms per sample, dragon 3.89 -> 3.48 with the 16M-path waves, same images).
     uint32_t leaves_per_round = 2;
     float threshold = NB_VISIBILITY_THRESHOLD;
-    // Leaf-binned query order (shared/neural_gpu.h NB_NL_SORT_*, --neural-sort-queries): each batched
-    // round's pairs are evaluated bin by bin of their leaf, so a subgroup's hash-grid gathers share
-    // cache lines; one counting-sort pass per round. Same image either way.
-    bool sort_queries = true;
 };
 
 // Leaves per round of `options` (throws nbvh::Error when out of range).
@@ -110,7 +106,6 @@ public:
     uint32_t rounds() const { return rounds_; }
     uint32_t batched_rounds() const { return batched_; }
     uint32_t leaves_per_round() const { return params_.leaves_per_round; }
-    bool sorted() const { return params_.sort_queries != 0u; }
     const GpuNeuralParams& params() const { return params_; }
 
 private:

@@ -20,7 +20,7 @@ namespace {
 
 enum Pass : size_t {
     CAMERA, QUEUE_ARGS, TRAVERSE, SHADE, SHADOW, ACCUMULATE, RESOLVE,
-    NEURAL_TRAVERSE, NEURAL_ARGS, NEURAL_QUERY, NEURAL_SHADOW, NEURAL_TAIL, NEURAL_SORT, // hybrid renders only (neural_stage.h)
+    NEURAL_TRAVERSE, NEURAL_ARGS, NEURAL_QUERY, NEURAL_SHADOW, NEURAL_TAIL, // hybrid renders only (neural_stage.h)
     PASS_COUNT
 };
 // NEURAL_QUERY's shader depends on the MLP path (NeuralStage::query_shader); this entry names its timer.
@@ -29,8 +29,7 @@ const char* const PASS_SHADERS[PASS_COUNT] = {"passes/camera_rays.comp", "passes
                                               "passes/shadow.comp",      "passes/accumulate.comp",
                                               "passes/resolve.comp",     "passes/neural_traverse.comp",
                                               "passes/neural_args.comp", "passes/neural_query.comp",
-                                              "passes/neural_shadow.comp", "passes/neural_tail.comp",
-                                              "passes/neural_sort.comp"};
+                                              "passes/neural_shadow.comp", "passes/neural_tail.comp"};
 
 template <class T> vk::Buffer upload(const vk::Context& ctx, const std::vector<T>& items, const char* name) {
     return vk::make_buffer(ctx, items, name);
@@ -229,7 +228,7 @@ void WavefrontRenderer::make_timer() {
                                                                std::max<uint64_t>(pixels, 1),
                                                            wave_samples_, MAX_SAMPLES_PER_SUBMISSION));
     const uint32_t waves = (samples_per_submission_ + wave_samples_ - 1) / wave_samples_;
-    const uint32_t per_wave = 2 + (8 + (neural_ ? 8 * neural_->batched_rounds() + 8 : 0)) * options_.max_depth;
+    const uint32_t per_wave = 2 + (8 + (neural_ ? 6 * neural_->batched_rounds() + 8 : 0)) * options_.max_depth;
     timer_ = vk::GpuTimer(ctx_, 62 + per_wave * waves);
 }
 
@@ -318,14 +317,13 @@ void WavefrontRenderer::record_neural_rounds(vk::CommandBuffer& cmd, size_t trav
     const uint32_t batched = neural_->batched_rounds();
     for (uint32_t round = 0; round < batched; ++round) {
         const uint32_t half = round & 1u;
-        record_pass(cmd, NEURAL_ARGS, constants(q, depth, w, half << 2), Dispatch::single);
-        if (neural_->sorted()) record_pass(cmd, NEURAL_SORT, constants(q, depth, w, half << 2), Dispatch::indirect_pending);
+        record_pass(cmd, NEURAL_ARGS, constants(q, depth, w, 0), Dispatch::single);
         record_pass(cmd, NEURAL_QUERY, constants(q, depth, w, half << 2), Dispatch::indirect_pending);
         record_pass(cmd, traverse_pass, constants(q, depth, w, 1u | ((half ^ 1u) << 2)),
                     Dispatch::indirect_pending);
     }
     // The few rays left finish in one pass (query, resume, query, ... per invocation).
-    record_pass(cmd, NEURAL_ARGS, constants(q, depth, w, ((batched & 1u) << 2) | NB_NL_ARGS_TAIL), Dispatch::single);
+    record_pass(cmd, NEURAL_ARGS, constants(q, depth, w, 0), Dispatch::single);
     record_pass(cmd, NEURAL_TAIL, constants(q, depth, w, (batched & 1u) << 2), Dispatch::indirect_pending);
 }
 

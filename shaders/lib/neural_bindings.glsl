@@ -23,25 +23,8 @@ layout(set = 0, binding = NB_BIND_NEURAL_STATE, scalar) buffer NeuralStateBuffer
 layout(set = 0, binding = NB_BIND_NEURAL_PARAMS, scalar) readonly buffer NeuralParamsBuffer { GpuNeuralParams neural_params; };
 layout(set = 0, binding = NB_BIND_NEURAL_ASSETS, scalar) readonly buffer NeuralAssetBuffer { GpuNeuralAsset neural_assets[]; };
 layout(set = 0, binding = NB_BIND_NEURAL_COUNTERS, scalar) coherent buffer NeuralCountersBuffer { GpuNeuralCounters neural_counters; };
-// Leaf-binned query order (shared/neural_gpu.h NB_NL_SORT_*): bins of both pending halves, then the order.
-layout(set = 0, binding = NB_BIND_NEURAL_SORT, std430) buffer NeuralSortBuffer {
-    uint nl_bins[NB_NL_SORT_HEADER_WORDS];
-    uint nl_order[];
-};
 
 // Slot k of half `half_` of the pending queue (each half holds leaves_per_round pairs per ray).
 uint nb_nl_pending_index(uint half_, uint k) { return half_ * ray_capacity() * neural_params.leaves_per_round + k; }
-
-// Pass-constant encoding of the neural passes: bits 0-1 the operation, bit 2 the half of the pending
-// queue (ping-pong: a resumed traversal reads its rays from the half just queried and queues into the
-// other one; neural_args: bit 3 NB_NL_ARGS_TAIL).
-uint nb_nl_op(uint mode) { return mode & 3u; }
-uint nb_nl_half(uint mode) { return (mode >> 2u) & 1u; }
-
-bool nb_nl_sorted() { return neural_params.sort_queries != 0u; }
-// Counter of `leaf`'s bin in half `half_` of nl_bins.
-uint nb_nl_bin_index(uint half_, uint leaf) {
-    return half_ * NB_NL_SORT_BINS + nb_nl_sort_bin(neural_params.box, nbvh_bounds[2u * leaf], nbvh_bounds[2u * leaf + 1u]);
-}
 
 #endif

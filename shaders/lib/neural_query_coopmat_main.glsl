@@ -10,7 +10,7 @@
 layout(local_size_x = NB_NEURAL_GROUP) in;
 
 void main() {
-    NbPendingQuery r = nb_load_pending(nb_query_pair(gl_GlobalInvocationID.x));
+    NbPendingQuery r = nb_load_pending(gl_GlobalInvocationID.x);
     vec3 p0, p1, p2;
     nb_segment_points(neural_params.box, r.org, r.dir, r.pl.t_enter, r.pl.t_exit, p0, p1, p2);
     nb_coop_stage_features(gl_LocalInvocationID.x, r.valid, p0, p1, p2);

@@ -14,12 +14,6 @@ struct NbPendingQuery {
     vec3 dir;
 };
 
-// The pair invocation k of a query pass evaluates: k itself, or with the leaf-binned order the pair
-// order[k] (passes/neural_sort.comp). The tail pass reads pairs in queue order (groups are contiguous).
-uint nb_query_pair(uint k) {
-    return nb_nl_sorted() && k < neural_counters.pending_active ? nl_order[k] : k;
-}
-
 // Pair k of pending half nb_nl_half(pc.mode) (neural_traverse.glsl). Rays >= capacity are shadow
 // rays (shadow SOA index ray - capacity), the others path rays of queue pc.in_queue.
 NbPendingQuery nb_load_pending(uint k) {

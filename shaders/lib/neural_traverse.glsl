@@ -97,6 +97,12 @@ void nb_traverse_neural_instance(uint instance) {
     g_tmax = saved_tmax;
 }
 
+// Pass-constant encoding of the neural passes: bits 0-1 the operation, bit 2 the half of the pending
+// queue (ping-pong: a resumed traversal reads its rays from the half just queried and queues into the
+// other one).
+uint nb_nl_op(uint mode) { return mode & 3u; }
+uint nb_nl_half(uint mode) { return (mode >> 2u) & 1u; }
+
 // Leaves a ray may queue in its next traversal: the round size, within its leaf budget.
 uint nb_nl_want(GpuNeuralRayState st) {
     uint left = neural_params.max_rounds > st.rounds ? neural_params.max_rounds - st.rounds : 0u;
@@ -126,7 +132,6 @@ bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, inout GpuN
         pl.hit_normal = vec3(0.0f, 0.0f, 1.0f);
         pl.hit_albedo = vec3(0.0f);
         pending_leaves[nb_nl_pending_index(half_, k + j)] = pl;
-        if (nb_nl_sorted()) atomicAdd(nl_bins[nb_nl_bin_index(half_, pl.leaf)], 1u);
     }
     st.key_t = g_nl_cand_t[n - 1u];
     st.key_instance = g_nl_cand_inst[n - 1u];

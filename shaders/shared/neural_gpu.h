@@ -145,7 +145,7 @@ struct GpuNeuralParams {
     float threshold;      // visibility threshold
     uint max_rounds;      // leaves queried per ray at most (then the best hit so far is kept)
     uint leaves_per_round; // 1..NB_NL_MAX_LEAVES_PER_ROUND leaves queued per ray per traversal round
-    uint sort_queries;    // 1: leaf-binned query order (NB_NL_SORT_*), 0: queue order
+    uint pad1;
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 64, "GpuNeuralParams layout");
 
@@ -158,41 +158,6 @@ struct GpuNeuralCounters {
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralCounters) == 16, "GpuNeuralCounters layout");
 
-// Leaf-binned query order (NeuralRenderOptions::sort_queries): the query pass visits a round's pairs
-// bin by bin, bins in Morton order of a 16^3 grid over the encoding box, a pair's bin that of its
-// leaf box's centre. Pairs of one bin, and of neighbouring bins, read the same coarse hash-grid cells
-// (levels 0-3 are 8..64 cells per axis), so a subgroup's gathers touch few cache lines instead of one
-// line per lane. (N-BVH node numbers follow the training's split order, not space: no key of its own.)
-// A counting sort per round: the traversal that queues a pair counts it in its half's bins, the args
-// pass turns the counts into bin offsets (exclusive scan), passes/neural_sort.comp scatters the pair
-// indices into the order array, the query pass reads pair order[k]. The order within a bin is whatever
-// the atomics give: each pair's result goes to its own slot, so the image does not depend on it.
-#define NB_NL_SORT_AXIS_BITS 4u
-#define NB_NL_SORT_BINS 4096u            // (1 << NB_NL_SORT_AXIS_BITS)^3
-#define NB_NL_SORT_SCAN_THREADS 1024u    // passes/neural_args.comp: 4 bins per invocation
-#define NB_NL_ARGS_TAIL 8u               // neural_args mode bit: before the tail pass (zero both halves)
-// Spreads the low 4 bits of v to bits 0, 3, 6, 9.
-NB_FN uint nb_nl_spread4(uint v) {
-    v &= 0xFu;
-    v = (v | (v << 4u)) & 0xC3u;  // bits 0,1 -> 0,1; bits 2,3 -> 6,7
-    v = (v | (v << 2u)) & 0x249u; // -> 0, 3, 6, 9
-    return v;
-}
-// Bin of a leaf with object-space box [lo, hi] in a model with encoding box `box`: the Morton code
-// (x lowest) of the 16^3 cell that holds the encoded centre (outside [0,1): the border cells).
-NB_FN uint nb_nl_sort_bin(GpuEncodingBox box, vec3 lo, vec3 hi) {
-    vec3 e = nb_encode_point(box, (lo + hi) * 0.5f);
-    float cells = float(1u << NB_NL_SORT_AXIS_BITS);
-    uint cx = uint(clamp(e.x * cells, 0.0f, cells - 1.0f));
-    uint cy = uint(clamp(e.y * cells, 0.0f, cells - 1.0f));
-    uint cz = uint(clamp(e.z * cells, 0.0f, cells - 1.0f));
-    return nb_nl_spread4(cx) | (nb_nl_spread4(cy) << 1u) | (nb_nl_spread4(cz) << 2u);
-}
-// Layout of the sort binding: two halves of NB_NL_SORT_BINS counters (one per pending half: counts
-// while a traversal queues, bin offsets once the args pass has scanned them), then the order array
-// (leaves_per_round x ray capacity pair indices: one half's pairs).
-#define NB_NL_SORT_HEADER_WORDS (2u * NB_NL_SORT_BINS)
-
 // Bindings of the renderer's set 0 after shared/scene_gpu.h's NB_BINDING_COUNT (20).
 #define NB_BIND_NEURAL_LEVELS 20u
 #define NB_BIND_NEURAL_GRID 21u
@@ -204,7 +169,6 @@ NB_FN uint nb_nl_sort_bin(GpuEncodingBox box, vec3 lo, vec3 hi) {
 #define NB_BIND_NEURAL_COUNTERS 27u
 #define NB_BIND_NEURAL_MLP_T 28u    // the weights with each matrix transposed (cooperative-matrix pass)
 #define NB_BIND_NEURAL_ASSETS 29u   // GpuNeuralAsset[]
-#define NB_BIND_NEURAL_SORT 30u     // uint[]: bins and order of the leaf-binned query order (above)
-#define NB_NEURAL_BINDING_END 31u
+#define NB_NEURAL_BINDING_END 30u
 
 #endif

@@ -2,8 +2,6 @@
 // and the cooperative-matrix path on the same random queries, and how far the two paths agree.
 //   nbvh_bench_neural [--model M.nbvh] [--queries N] [--reps R] [--device auto|gpu|cpu] [--json out.json]
 //                     [--coherent]   (camera-ray ordered queries instead of random ones)
-//                     [--binned]     (the random queries in the renderer's leaf-binned order: sorted by
-//                                     nb_nl_sort_bin of their leaf box, as --neural-sort-queries on does)
 // Without --model a random network with varied outputs (tests/neuralvk/neural_test_model.h, hash 2^18,
 // the paper's size) is used: the kernels' cost does not depend on the weights' values.
 // Queries: random rays through random leaf-sized boxes of the asset, a quarter starting inside.
@@ -12,7 +10,6 @@
 #include "engine/vk/context.h"
 #include "tests/neuralvk/neural_test_model.h"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -25,12 +22,10 @@ using namespace nbvh::render;
 
 namespace {
 
-std::vector<GpuNeuralQuery> make_queries(size_t n, glm::vec3 lo, glm::vec3 hi, uint64_t seed,
-                                         const GpuEncodingBox* binned_by = nullptr) {
+std::vector<GpuNeuralQuery> make_queries(size_t n, glm::vec3 lo, glm::vec3 hi, uint64_t seed) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     std::vector<GpuNeuralQuery> out;
-    std::vector<uint32_t> bins;
     out.reserve(n);
     const glm::vec3 ext = hi - lo;
     while (out.size() < n) {
@@ -44,16 +39,8 @@ std::vector<GpuNeuralQuery> make_queries(size_t n, glm::vec3 lo, glm::vec3 hi, u
         q.dir = dir;
         if (!nb_neural_leaf_interval(org, nb_safe_inv_dir(dir), llo, lhi, q.t_entry, q.t_exit)) continue;
         out.push_back(q);
-        if (binned_by) bins.push_back(nb_nl_sort_bin(*binned_by, llo, lhi));
     }
-    if (!binned_by) return out;
-    std::vector<size_t> order(out.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return bins[a] < bins[b]; });
-    std::vector<GpuNeuralQuery> sorted;
-    sorted.reserve(out.size());
-    for (size_t i : order) sorted.push_back(out[i]);
-    return sorted;
+    return out;
 }
 
 // Coherent queries, as camera rays produce them: a pinhole camera looking at the asset, one ray per
@@ -94,7 +81,7 @@ int main(int argc, char** argv) try {
     std::string model_path, json_path, device = "auto";
     size_t n = size_t(1) << 22;
     int reps = 10;
-    bool coherent = false, binned = false;
+    bool coherent = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
@@ -107,7 +94,6 @@ int main(int argc, char** argv) try {
         else if (a == "--device") device = next();
         else if (a == "--json") json_path = next();
         else if (a == "--coherent") coherent = true;
-        else if (a == "--binned") binned = true;
         else throw Error("unknown option " + a);
     }
     vk::ContextOptions o;
@@ -121,14 +107,10 @@ int main(int argc, char** argv) try {
     NeuralModel model = tm.model;
     if (!model_path.empty()) model = load_model(model_path);
     NeuralModelGpu gpu(ctx, model);
-    if (coherent && binned) throw Error("--coherent and --binned are two query orders: pick one");
-    const GpuEncodingBox box = encoding_box_of(model);
     const std::vector<GpuNeuralQuery> qs =
         coherent ? make_coherent_queries(n, model.encoding_box.lo, model.encoding_box.hi)
-                 : make_queries(n, model.encoding_box.lo, model.encoding_box.hi, 1234, binned ? &box : nullptr);
-    const char* order = coherent ? "coherent" : binned ? "binned" : "random";
-    std::printf("%zu %s queries\n", qs.size(),
-                coherent ? "coherent (camera-ray order)" : binned ? "random, leaf-binned order" : "random incoherent");
+                 : make_queries(n, model.encoding_box.lo, model.encoding_box.hi, 1234);
+    std::printf("%zu %s queries\n", qs.size(), coherent ? "coherent (camera-ray order)" : "random incoherent");
 
     struct Row { std::string path; double ms = 0; double qps = 0; std::vector<GpuNeuralHit> hits; };
     std::vector<Row> rows;
@@ -194,7 +176,7 @@ int main(int argc, char** argv) try {
     if (!json_path.empty()) {
         std::ofstream f(json_path);
         f << "{\n  \"device\": \"" << dev.device_name << "\",\n  \"driver\": \"" << dev.driver_name << " "
-          << dev.driver_info << "\",\n  \"queries\": " << qs.size() << ",\n  \"query_order\": \"" << order << "\",\n  \"reps\": " << reps
+          << dev.driver_info << "\",\n  \"queries\": " << qs.size() << ",\n  \"query_order\": \"" << (coherent ? "coherent" : "random") << "\",\n  \"reps\": " << reps
           << ",\n  \"model\": \"" << (model_path.empty() ? "random (hash 2^18)" : model_path) << "\",\n  \"paths\": [";
         for (size_t i = 0; i < rows.size(); ++i)
             f << (i ? ", " : "") << "{\"path\": \"" << rows[i].path << "\", \"ms\": " << rows[i].ms

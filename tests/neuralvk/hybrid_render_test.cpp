@@ -44,8 +44,7 @@ struct Rendered {
 Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPath::scalar, float threshold = 0.5f,
                       uint32_t lod = 0, int32_t secondary_lod = -1, uint32_t batched_rounds = 256,
                       uint32_t leaves_per_round = NeuralRenderOptions{}.leaves_per_round,
-                      uint32_t max_leaves = NeuralRenderOptions{}.max_rounds,
-                      bool sort_queries = NeuralRenderOptions{}.sort_queries) {
+                      uint32_t max_leaves = NeuralRenderOptions{}.max_rounds) {
     vk::ContextOptions co;
     co.device = vk::DeviceChoice::cpu;
     co.validation = true;
@@ -67,7 +66,6 @@ Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPat
     o.neural.batched_rounds = batched_rounds;
     o.neural.leaves_per_round = leaves_per_round;
     o.neural.max_rounds = max_leaves;
-    o.neural.sort_queries = sort_queries;
     if (hybrid) o.neural.model = &f.model;
     else o.neural.classical = true;
     WavefrontRenderer r(ctx, f.scene, accel, default_sky(), cam, o);
@@ -190,39 +188,6 @@ TEST(HybridRender, LeavesPerRoundKeepTheImage) {
     EXPECT_GE(k2.stats.neural_queries, k1.stats.neural_queries);
     EXPECT_GE(k4.stats.neural_queries, k2.stats.neural_queries);
     EXPECT_LT(k4.stats.neural_rounds, k1.stats.neural_rounds);
-}
-
-bool ran_pass(const Rendered& r, const std::string& name) {
-    for (const auto& [pass, ms] : r.stats.pass_ms)
-        if (pass == name) return true;
-    return false;
-}
-
-// The leaf-binned query order (--neural-sort-queries, passes/neural_sort.comp) evaluates the same pairs
-// in another order: the same image and the same queries and rounds, with one leaf per round and with
-// several, with and without the tail pass. A pair the sort dropped or duplicated would leave a hit out.
-TEST(HybridRender, SortedQueriesKeepTheImage) {
-    NBVH_REQUIRE_SHARED();
-    const Fixture& f = trained_bunny();
-    for (uint32_t k : {1u, 2u, 4u})
-        for (uint32_t batched : {256u, 1u}) {
-            const Rendered plain = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, 1, batched, k, 8, false);
-            const Rendered sorted = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, 1, batched, k, 8, true);
-            EXPECT_EQ(plain.validation + sorted.validation, 0);
-            EXPECT_FALSE(ran_pass(plain, "passes/neural_sort.comp"));
-            if (!sorted.stats.pass_ms.empty()) EXPECT_TRUE(ran_pass(sorted, "passes/neural_sort.comp"));
-            ASSERT_EQ(plain.image.data.size(), sorted.image.data.size());
-            size_t differ = 0;
-            for (size_t i = 0; i < plain.image.data.size(); ++i) differ += plain.image.data[i] != sorted.image.data[i];
-            std::printf("%u leaves per round, %u batched rounds: %llu queries, %llu rounds; %zu of %zu values differ\n",
-                        k, batched, (unsigned long long)sorted.stats.neural_queries,
-                        (unsigned long long)sorted.stats.neural_rounds, differ, plain.image.data.size());
-            EXPECT_EQ(differ, 0u);
-            EXPECT_GT(sorted.stats.neural_queries, 0u);
-            EXPECT_EQ(plain.stats.neural_queries, sorted.stats.neural_queries);
-            EXPECT_EQ(plain.stats.neural_rounds, sorted.stats.neural_rounds);
-            EXPECT_EQ(plain.stats.neural_leaf_cap_rays, sorted.stats.neural_leaf_cap_rays);
-        }
 }
 
 TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
