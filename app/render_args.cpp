@@ -25,9 +25,6 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
                     "neural leaves queried per ray at most (then the closest hit so far is kept)");
     cmd->add_option("--neural-batched-rounds", o.neural.batched_rounds,
                     "leaf rounds through the batched query pass before the per-ray tail pass");
-    cmd->add_option("--neural-tail-depth", o.neural.tail_depth,
-                    "bounce from which neural leaves are finished by the per-ray tail pass alone (0 = camera rays; "
-                    ">= --max-depth: never)");
     cmd->add_option("--neural-leaves-per-round", o.neural.leaves_per_round,
                     "neural leaves a ray queues per traversal round (speculative ones included; same image)");
     cmd->add_option("--wave-pixels", o.max_wave_pixels,

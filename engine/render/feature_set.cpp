@@ -131,7 +131,6 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
     p.leaf_budget = stage.rounds();
     p.leaves_per_round = stage.leaves_per_round();
     p.batched_rounds = stage.batched_rounds();
-    p.tail_depth = stage.tail_depth();
     for (const Instance& inst : scene.instances) p.instances += inst.neural;
     p.assets = uint32_t(o.model->assets.size());
     return p;
@@ -198,9 +197,6 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
                     n->lod_primary, n->lod_secondary, n->lod_count);
         s += strfmt("  leaves per ray  at most %u, %u queued per round: %u batched round%s, then neural_tail\n",
                     n->leaf_budget, n->leaves_per_round, n->batched_rounds, n->batched_rounds == 1 ? "" : "s");
-        if (n->tail_depth < max_depth)
-            s += strfmt("  deep bounces    from bounce %u on (0 = camera rays): neural_tail only, no batched rounds\n",
-                        n->tail_depth);
     } else {
         s += strfmt("  neural assets   %s\n", yn(f.neural));
     }

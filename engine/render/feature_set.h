@@ -67,7 +67,6 @@ struct NeuralPlan {
     uint32_t leaf_budget = 0;      // leaves queried per ray at most (--neural-max-leaves)
     uint32_t leaves_per_round = 0; // leaves a ray queues per round
     uint32_t batched_rounds = 0;   // rounds through the batched query pass before neural_tail
-    uint32_t tail_depth = 256;     // bounces from this depth on: neural_tail only
     uint32_t instances = 0, assets = 0;
 };
 

@@ -26,7 +26,6 @@ void validate(const NeuralRenderOptions& o, const Scene& scene) {
     if (!(o.metallic <= 1.0f)) throw Error("--neural-metallic must be in [0, 1]");
     if (o.max_rounds == 0 || o.max_rounds > 256) throw Error("--neural-max-leaves must be in 1..256");
     if (o.batched_rounds > 256) throw Error("--neural-batched-rounds must be in 0..256");
-    if (o.tail_depth > 256) throw Error("--neural-tail-depth must be in 0..256");
     if (!(o.threshold > 0.0f && o.threshold < 1.0f)) throw Error("the visibility threshold must be in (0, 1)");
     bool any = false;
     for (const Instance& i : scene.instances) any = any || i.neural;
@@ -160,7 +159,6 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     // in front of its hit): after ceil(max_rounds / leaves_per_round) rounds no ray is left.
     const uint32_t needed = (o.max_rounds + params_.leaves_per_round - 1) / params_.leaves_per_round;
     batched_ = std::min(needed, o.batched_rounds);
-    tail_depth_ = o.tail_depth;
     params_.box = model_.box();
     params_.lod_primary = std::min(o.lod, model_.lod_count() - 1);
     const uint32_t coarsest = model_.lod_count() - 1;

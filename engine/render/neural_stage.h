@@ -49,10 +49,6 @@ struct NeuralRenderOptions {
     // invocation per ray, scalar queries). Default: all rounds batched (the tail measured slower on the
     // H200: its longest ray serialises ~10 scalar queries per pass).
     uint32_t batched_rounds = 256;
-    // Bounces from this depth on (0 = camera rays) skip the batched rounds: neural_tail finishes their
-    // leaves in one dispatch. Deep bounces hold few rays, and each batched round costs three dependent
-    // dispatches that such small waves cannot fill (--neural-tail-depth; >= --max-depth: never).
-    uint32_t tail_depth = 256;
     // Leaves a ray queues per round (1..NB_NL_MAX_LEAVES_PER_ROUND): the next ones in key order in front
     // of its best hit, so one traversal and one query round serve several leaf visits (the extra ones
     // are speculative: their hits cannot beat the closest, same image). --neural-leaves-per-round.
@@ -109,9 +105,6 @@ public:
     const char* query_shader() const;
     uint32_t rounds() const { return rounds_; }
     uint32_t batched_rounds() const { return batched_; }
-    // Batched rounds of the bounce at `depth` (none from the tail depth on).
-    uint32_t batched_rounds(uint32_t depth) const { return depth >= tail_depth_ ? 0u : batched_; }
-    uint32_t tail_depth() const { return tail_depth_; }
     uint32_t leaves_per_round() const { return params_.leaves_per_round; }
     const GpuNeuralParams& params() const { return params_; }
 
@@ -129,7 +122,6 @@ private:
     std::vector<GpuNeuralAsset> assets_;
     uint32_t rounds_ = 0;
     uint32_t batched_ = 0;
-    uint32_t tail_depth_ = 256;
     uint32_t capacity_ = 0;
 };
 

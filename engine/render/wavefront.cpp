@@ -314,7 +314,7 @@ void WavefrontRenderer::record_neural_rounds(vk::CommandBuffer& cmd, size_t trav
                                              const Wave& w) {
     const Dispatch all = traverse_pass == NEURAL_SHADOW ? Dispatch::indirect_shadow : Dispatch::indirect_rays;
     record_pass(cmd, traverse_pass, constants(q, depth, w, 0), all);
-    const uint32_t batched = neural_->batched_rounds(depth);
+    const uint32_t batched = neural_->batched_rounds();
     for (uint32_t round = 0; round < batched; ++round) {
         const uint32_t half = round & 1u;
         record_pass(cmd, NEURAL_ARGS, constants(q, depth, w, 0), Dispatch::single);

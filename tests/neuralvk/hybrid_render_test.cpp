@@ -44,8 +44,7 @@ struct Rendered {
 Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPath::scalar, float threshold = 0.5f,
                       uint32_t lod = 0, int32_t secondary_lod = -1, uint32_t batched_rounds = 256,
                       uint32_t leaves_per_round = NeuralRenderOptions{}.leaves_per_round,
-                      uint32_t max_leaves = NeuralRenderOptions{}.max_rounds,
-                      uint32_t tail_depth = NeuralRenderOptions{}.tail_depth) {
+                      uint32_t max_leaves = NeuralRenderOptions{}.max_rounds) {
     vk::ContextOptions co;
     co.device = vk::DeviceChoice::cpu;
     co.validation = true;
@@ -67,7 +66,6 @@ Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPat
     o.neural.batched_rounds = batched_rounds;
     o.neural.leaves_per_round = leaves_per_round;
     o.neural.max_rounds = max_leaves;
-    o.neural.tail_depth = tail_depth;
     if (hybrid) o.neural.model = &f.model;
     else o.neural.classical = true;
     WavefrontRenderer r(ctx, f.scene, accel, default_sky(), cam, o);
@@ -192,32 +190,6 @@ TEST(HybridRender, LeavesPerRoundKeepTheImage) {
     EXPECT_LT(k4.stats.neural_rounds, k1.stats.neural_rounds);
 }
 
-// --neural-tail-depth: bounces from the tail depth on skip the batched rounds and neural_tail finishes
-// them (one leaf per iteration, no speculative leaves): the same image whether the tail takes every
-// bounce, the bounces after the first hit or none; fewer queries where the tail takes over (2 leaves per
-// round queue a speculative one), fewer batched rounds.
-TEST(HybridRender, TailDepthKeepsTheImage) {
-    NBVH_REQUIRE_SHARED();
-    const Fixture& f = trained_bunny();
-    const uint32_t k = NeuralRenderOptions{}.leaves_per_round, leaves = NeuralRenderOptions{}.max_rounds;
-    const Rendered none = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, 1, 256, k, leaves, 256);
-    const Rendered deep = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, 1, 256, k, leaves, 1);
-    const Rendered all = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, 1, 256, k, leaves, 0);
-    EXPECT_EQ(none.validation + deep.validation + all.validation, 0);
-    const float fd = flip_hdr(none.image, deep.image).mean;
-    const float fa = flip_hdr(none.image, all.image).mean;
-    std::printf("tail depth none vs 1: FLIP %.2e, vs 0: %.2e; queries %llu / %llu / %llu, rounds %llu / %llu / %llu\n", fd,
-                fa, (unsigned long long)none.stats.neural_queries, (unsigned long long)deep.stats.neural_queries,
-                (unsigned long long)all.stats.neural_queries, (unsigned long long)none.stats.neural_rounds,
-                (unsigned long long)deep.stats.neural_rounds, (unsigned long long)all.stats.neural_rounds);
-    EXPECT_LT(fd, 1e-3f);
-    EXPECT_LT(fa, 1e-3f);
-    EXPECT_LT(deep.stats.neural_queries, none.stats.neural_queries);
-    EXPECT_LT(all.stats.neural_queries, deep.stats.neural_queries);
-    EXPECT_LT(deep.stats.neural_rounds, none.stats.neural_rounds);
-    EXPECT_LE(all.stats.neural_rounds, deep.stats.neural_rounds);
-}
-
 TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
     NBVH_REQUIRE_SHARED();
     Fixture f; // no training needed: validate() reads the scene's neural flags and the model's LoD count
@@ -236,9 +208,6 @@ TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
     o.max_rounds = 0;
     EXPECT_THROW(validate(o, f.scene), Error);
     o.max_rounds = 8;
-    o.tail_depth = 257;
-    EXPECT_THROW(validate(o, f.scene), Error);
-    o.tail_depth = 256;
     o.leaves_per_round = 0;
     EXPECT_THROW(validate(o, f.scene), Error);
     o.leaves_per_round = NB_NL_MAX_LEAVES_PER_ROUND + 1;
