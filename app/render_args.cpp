@@ -27,9 +27,6 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
                     "leaf rounds through the batched query pass before the per-ray tail pass");
     cmd->add_option("--neural-leaves-per-round", o.neural.leaves_per_round,
                     "neural leaves a ray queues per traversal round (speculative ones included; same image)");
-    cmd->add_option("--neural-first-round-leaves", o.neural.first_round_leaves,
-                    "neural leaves a ray queues in its first round (1..leaves per round; same image)")
-        ->check(CLI::Range(1u, NB_NL_MAX_LEAVES_PER_ROUND));
     cmd->add_option("--wave-pixels", o.max_wave_pixels,
                     "paths traced per wave (rays per queue; several samples of each pixel while they fit in 16M paths, "
                     "up to 16; also bounded by the device's buffer, memory and dispatch limits)")

@@ -26,8 +26,6 @@ void validate(const NeuralRenderOptions& o, const Scene& scene) {
     if (!(o.metallic <= 1.0f)) throw Error("--neural-metallic must be in [0, 1]");
     if (o.max_rounds == 0 || o.max_rounds > 256) throw Error("--neural-max-leaves must be in 1..256");
     if (o.batched_rounds > 256) throw Error("--neural-batched-rounds must be in 0..256");
-    if (o.first_round_leaves > o.leaves_per_round)
-        throw Error(strfmt("--neural-first-round-leaves must be in 1..%u (--neural-leaves-per-round)", o.leaves_per_round));
     if (!(o.threshold > 0.0f && o.threshold < 1.0f)) throw Error("the visibility threshold must be in (0, 1)");
     bool any = false;
     for (const Instance& i : scene.instances) any = any || i.neural;
@@ -157,12 +155,9 @@ const std::vector<uint32_t>& NeuralStage::model_bindings() {
 void NeuralStage::set_params(const NeuralRenderOptions& o) {
     rounds_ = o.max_rounds;
     params_.leaves_per_round = effective_leaves_per_round(o);
-    const uint32_t k = params_.leaves_per_round;
-    params_.first_round_leaves = o.first_round_leaves == 0 ? k : std::min(o.first_round_leaves, k);
-    // Every round queues leaves_per_round leaves (first_round_leaves in the first) per ray still going, or
-    // finishes it (fewer leaves left in front of its hit): after that many rounds no ray is left.
-    const uint32_t first = std::min(params_.first_round_leaves, o.max_rounds);
-    const uint32_t needed = 1 + (o.max_rounds - first + k - 1) / k;
+    // Every round queues leaves_per_round leaves per ray still going, or finishes it (fewer leaves left
+    // in front of its hit): after ceil(max_rounds / leaves_per_round) rounds no ray is left.
+    const uint32_t needed = (o.max_rounds + params_.leaves_per_round - 1) / params_.leaves_per_round;
     batched_ = std::min(needed, o.batched_rounds);
     params_.box = model_.box();
     params_.lod_primary = std::min(o.lod, model_.lod_count() - 1);

@@ -56,10 +56,6 @@ struct NeuralRenderOptions {
     // so a 1080p hybrid wave holds 8 samples (H200, 1080p 16 spp, results/perf/knobs_h200.txt: default
     // scene 7.03 -> 6.62 ms per sample, dragon 3.89 -> 3.48 with the 16M-path waves, same images).
     uint32_t leaves_per_round = 2;
-    // Leaves of a ray's first round (1..leaves_per_round; 0: leaves_per_round). Most rays that reach a
-    // neural asset hit its first leaf: a speculative second query is wasted on them, but without it
-    // they are re-traversed once to rule out a closer overlapping leaf. --neural-first-round-leaves.
-    uint32_t first_round_leaves = 0;
     float threshold = NB_VISIBILITY_THRESHOLD;
 };
 

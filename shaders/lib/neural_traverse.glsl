@@ -103,12 +103,10 @@ void nb_traverse_neural_instance(uint instance) {
 uint nb_nl_op(uint mode) { return mode & 3u; }
 uint nb_nl_half(uint mode) { return (mode >> 2u) & 1u; }
 
-// Leaves a ray may queue in its next traversal: the round size (first_round_leaves before any leaf was
-// queried), within its leaf budget.
+// Leaves a ray may queue in its next traversal: the round size, within its leaf budget.
 uint nb_nl_want(GpuNeuralRayState st) {
     uint left = neural_params.max_rounds > st.rounds ? neural_params.max_rounds - st.rounds : 0u;
-    uint k = st.rounds == 0u ? neural_params.first_round_leaves : neural_params.leaves_per_round;
-    return max(1u, min(min(k, NB_NL_MAX_LEAVES_PER_ROUND), left));
+    return max(1u, min(min(neural_params.leaves_per_round, NB_NL_MAX_LEAVES_PER_ROUND), left));
 }
 
 // Queues the candidates of the last traversal in front of `limit` (within the ray's leaf budget),

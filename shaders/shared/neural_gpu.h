@@ -145,7 +145,7 @@ struct GpuNeuralParams {
     float threshold;      // visibility threshold
     uint max_rounds;      // leaves queried per ray at most (then the best hit so far is kept)
     uint leaves_per_round; // 1..NB_NL_MAX_LEAVES_PER_ROUND leaves queued per ray per traversal round
-    uint first_round_leaves; // 1..leaves_per_round: leaves of a ray's first round (its first traversal)
+    uint pad1;
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 64, "GpuNeuralParams layout");
 

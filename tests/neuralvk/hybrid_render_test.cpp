@@ -44,8 +44,7 @@ struct Rendered {
 Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPath::scalar, float threshold = 0.5f,
                       uint32_t lod = 0, int32_t secondary_lod = -1, uint32_t batched_rounds = 256,
                       uint32_t leaves_per_round = NeuralRenderOptions{}.leaves_per_round,
-                      uint32_t max_leaves = NeuralRenderOptions{}.max_rounds,
-                      uint32_t first_round_leaves = NeuralRenderOptions{}.first_round_leaves) {
+                      uint32_t max_leaves = NeuralRenderOptions{}.max_rounds) {
     vk::ContextOptions co;
     co.device = vk::DeviceChoice::cpu;
     co.validation = true;
@@ -67,7 +66,6 @@ Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPat
     o.neural.batched_rounds = batched_rounds;
     o.neural.leaves_per_round = leaves_per_round;
     o.neural.max_rounds = max_leaves;
-    o.neural.first_round_leaves = first_round_leaves;
     if (hybrid) o.neural.model = &f.model;
     else o.neural.classical = true;
     WavefrontRenderer r(ctx, f.scene, accel, default_sky(), cam, o);
@@ -192,38 +190,6 @@ TEST(HybridRender, LeavesPerRoundKeepTheImage) {
     EXPECT_LT(k4.stats.neural_rounds, k1.stats.neural_rounds);
 }
 
-// A first round of one leaf, then rounds of K: the same image as K leaves in every round (and as one),
-// fewer queries than K everywhere (no speculative query in the first round), rounds in between. With
-// the tail pass after one batched round too, and with a leaf budget of one (the first round spends it).
-TEST(HybridRender, FirstRoundLeavesKeepTheImage) {
-    NBVH_REQUIRE_SHARED();
-    const Fixture& f = trained_bunny();
-    const uint32_t budget = NeuralRenderOptions{}.max_rounds;
-    const Rendered k1 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 1);
-    const Rendered k4 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 4);
-    const Rendered f1 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 4, budget, 1);
-    const Rendered f1_tail = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 1, 4, budget, 1);
-    const Rendered cap1 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 1, 1);
-    const Rendered cap1_f1 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 4, 1, 1);
-    EXPECT_EQ(k1.validation + k4.validation + f1.validation + f1_tail.validation + cap1_f1.validation, 0);
-    const float a = flip_hdr(k4.image, f1.image).mean, b = flip_hdr(k1.image, f1.image).mean;
-    const float c = flip_hdr(k4.image, f1_tail.image).mean, d = flip_hdr(cap1.image, cap1_f1.image).mean;
-    std::printf("first round 1, then 4 vs 4: FLIP %.2e, vs 1: %.2e, + tail: %.2e, budget 1: %.2e; queries %llu / %llu / %llu "
-                "(1 / 4 / first 1), rounds %llu / %llu / %llu\n",
-                a, b, c, d, (unsigned long long)k1.stats.neural_queries, (unsigned long long)k4.stats.neural_queries,
-                (unsigned long long)f1.stats.neural_queries, (unsigned long long)k1.stats.neural_rounds,
-                (unsigned long long)k4.stats.neural_rounds, (unsigned long long)f1.stats.neural_rounds);
-    EXPECT_LT(a, 1e-3f);
-    EXPECT_LT(b, 1e-3f);
-    EXPECT_LT(c, 1e-3f);
-    EXPECT_LT(d, 1e-3f);
-    EXPECT_LT(f1.stats.neural_queries, k4.stats.neural_queries);
-    EXPECT_GE(f1.stats.neural_queries, k1.stats.neural_queries);
-    EXPECT_LT(f1.stats.neural_rounds, k1.stats.neural_rounds);
-    EXPECT_EQ(cap1.stats.neural_queries, cap1_f1.stats.neural_queries);
-    EXPECT_EQ(cap1.stats.neural_leaf_cap_rays, cap1_f1.stats.neural_leaf_cap_rays);
-}
-
 TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
     NBVH_REQUIRE_SHARED();
     Fixture f; // no training needed: validate() reads the scene's neural flags and the model's LoD count
@@ -242,9 +208,6 @@ TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
     o.max_rounds = 0;
     EXPECT_THROW(validate(o, f.scene), Error);
     o.max_rounds = 8;
-    o.first_round_leaves = 3; // more than leaves_per_round (2)
-    EXPECT_THROW(validate(o, f.scene), Error);
-    o.first_round_leaves = 0;
     o.leaves_per_round = 0;
     EXPECT_THROW(validate(o, f.scene), Error);
     o.leaves_per_round = NB_NL_MAX_LEAVES_PER_ROUND + 1;
