@@ -26,10 +26,9 @@ uint64_t wave_bytes_per_path(const RenderOptions& o) {
 }
 
 uint64_t counter_safe_paths(const RenderOptions& o) {
-    // Each counter on its own: rays (path or shadow) grow by at most 2 per bounce, queries by at most
-    // the leaf budget per path and shadow ray.
-    const uint64_t per_bounce = o.neural.model ? std::max(o.neural.max_rounds, 1u) : 1u;
-    const uint64_t per_path = 2ull * std::max(o.max_depth, 1u) * per_bounce;
+    // Rays (path or shadow) grow by at most 2 per path and bounce; the query counter, which grows with
+    // the leaf budget, is 64-bit (GpuNeuralCounters).
+    const uint64_t per_path = 2ull * std::max(o.max_depth, 1u);
     return std::max<uint64_t>((1ull << 31) / per_path, 64);
 }
 

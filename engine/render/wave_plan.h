@@ -34,10 +34,10 @@ constexpr uint32_t NB_WAVE_MAX_SAMPLES = 16;
 // (ray, leaf) pairs.
 uint64_t wave_bytes_per_path(const RenderOptions& o);
 
-// Paths one submission may trace without a statistics counter growing by 2^31 (they are 32-bit, read
-// after each submission): a path adds at most 2 * max_depth rays to a ray counter and, with a model, up
-// to the leaf budget's queries per ray to the query counter. With the options the renderer is built with (apply() may raise depth or
-// budget later: the statistics could then wrap on pathological settings, the image cannot).
+// Paths one submission may trace without a 32-bit statistics counter growing by 2^31 (read after each
+// submission): a path adds at most 2 * max_depth rays to a ray counter. The neural query counter, which
+// grows with the leaf budget, is 64-bit: the budget does not bound the wave. (apply() rebuilds instead of
+// raising max_depth past this bound for the built wave.)
 uint64_t counter_safe_paths(const RenderOptions& o);
 
 // No more samples per wave than o.spp: a renderer built for one sample per call (the viewer) keeps one

@@ -237,14 +237,15 @@ bool WavefrontRenderer::apply(const RenderOptions& o) {
     const NeuralRenderOptions &n = o.neural, &cn = c.neural;
     // What needs new buffers or pipelines: the film size and waves, a model where there was none (or
     // none where there was one), the MLP path, the pending-queue size, material overrides baked into a
-    // classical reference's triangles. Another model of the same scene is an upload (swap_model).
+    // classical reference's triangles, a depth whose rays could wrap a statistics counter within the built
+    // wave (wave_plan.h counter_safe_paths). Another model of the same scene is an upload (swap_model).
     const bool overrides = n.roughness >= 0.0f || n.metallic >= 0.0f;
     const bool swap = n.model && cn.model && n.model != cn.model && neural_;
     if (o.width != c.width || o.height != c.height || o.max_wave_pixels != c.max_wave_pixels ||
         (n.model != cn.model && !swap) || n.path != cn.path ||
         (n.model && effective_leaves_per_round(n) != neural_->leaves_per_round()) ||
         (n.classical && overrides) != classical_overrides_ || (n.model && !features_.neural && !n.classical) ||
-        !(o.forced_features == c.forced_features))
+        !(o.forced_features == c.forced_features) || capacity_ > counter_safe_paths(o))
         return false;
     if (n.model) validate(n, *scene_);
     if (swap) swap_model(n);
@@ -403,14 +404,14 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
             d[r.tag] += r.ms;
         }
     };
-    // The GPU's statistics counters are 32-bit and wrap within a long render (a 1080p frame at 4096 spp
-    // traces ~1e10 rays): they are read after every submission (each adds far less than 2^32) and the
-    // wrapped differences summed in 64 bits.
+    // The GPU's statistics counters are 32-bit (neural queries: 64-bit, GpuNeuralCounters) and wrap within
+    // a long render (a 1080p frame at 4096 spp traces ~1e10 rays): they are read after every submission
+    // (each adds less than 2^32, wave_plan.h counter_safe_paths) and the wrapped differences summed in 64 bits.
     // [0..6]: primary, secondary, shadow rays, non-finite samples, neural queries, rounds, leaf-cap rays;
     // then path rays and shadow rays per bounce (NB_STAT_DEPTHS each).
     constexpr size_t N = 7 + 2 * NB_STAT_DEPTHS;
     uint64_t totals[N] = {};
-    uint32_t last[N] = {};
+    uint64_t last[N] = {};
     // The counters are copied into counter_readback_ at the end of each submission (no extra round trip).
     auto record_counter_copy = [&] {
         cmd_.barrier(vk::Barrier::compute_to_transfer);
@@ -424,7 +425,7 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
         const char* mapped = static_cast<const char*>(counter_readback_.mapped());
         GpuQueueCounters c;
         std::memcpy(&c, mapped, sizeof(c));
-        uint32_t now[N] = {c.rays_primary, c.rays_secondary, c.rays_shadow, c.nonfinite_samples, 0, 0, 0};
+        uint64_t now[N] = {c.rays_primary, c.rays_secondary, c.rays_shadow, c.nonfinite_samples, 0, 0, 0};
         for (uint32_t d = 0; d < NB_STAT_DEPTHS; ++d) {
             now[7 + d] = c.rays_by_depth[d];
             now[7 + NB_STAT_DEPTHS + d] = c.shadow_rays_by_depth[d];
@@ -432,12 +433,12 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
         if (neural_) {
             GpuNeuralCounters nc;
             std::memcpy(&nc, mapped + sizeof(GpuQueueCounters), sizeof(nc));
-            now[4] = nc.queries_total;
+            now[4] = uint64_t(nc.queries_total_hi) << 32 | nc.queries_total;
             now[5] = nc.rounds;
             now[6] = nc.leaf_cap_rays;
         }
         for (size_t k = 0; k < N; ++k) {
-            totals[k] += uint32_t(now[k] - last[k]);
+            totals[k] += k == 4 ? now[k] - last[k] : uint32_t(now[k] - last[k]);
             last[k] = now[k];
         }
     };

@@ -11,7 +11,7 @@ void main() {
     uint n = counters.pending_count;
     counters.pending_count = 0u;
     neural_counters.pending_active = n;
-    neural_counters.queries_total += n;
+    nb_add_u64(neural_counters.queries_total, neural_counters.queries_total_hi, n);
     if (n > 0u) neural_counters.rounds += 1u;
     counters.pending_dispatch.x = (n + NB_NEURAL_GROUP - 1u) / NB_NEURAL_GROUP;
     counters.pending_dispatch.y = 1u;

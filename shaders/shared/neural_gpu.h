@@ -151,12 +151,26 @@ NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 64, "GpuNeuralParams layout");
 
 struct GpuNeuralCounters {
     uint pending_active;  // pairs the current neural_query dispatch processes
-    uint queries_total;   // statistics: queries of the render (path and shadow rays)
+    uint queries_total;   // statistics: queries of the render (path and shadow rays), low 32 bits
     uint leaf_cap_rays;   // statistics: rays (path and shadow) left with a leaf in front of their best hit
                           // when their leaf budget (max_rounds) was spent: truncated by the cap
     uint rounds;          // statistics: rounds with at least one pair
+    // High 32 bits of queries_total: the one statistic that grows with the leaf budget (up to max_rounds
+    // queries per ray), so that no wave size or --neural-max-leaves can wrap it within a submission (the
+    // ray counters grow by at most 2 per path and bounce: wave_plan.h counter_safe_paths).
+    uint queries_total_hi;
+    uint pad0;
+    uint pad1;
+    uint pad2;
 };
-NB_STATIC_ASSERT(sizeof(GpuNeuralCounters) == 16, "GpuNeuralCounters layout");
+NB_STATIC_ASSERT(sizeof(GpuNeuralCounters) == 32, "GpuNeuralCounters layout");
+
+// 64-bit counter (lo, hi) += n in 32-bit words (one writer at a time: passes/neural_args.comp).
+NB_FN void nb_add_u64(NB_INOUT(uint) lo, NB_INOUT(uint) hi, uint n) {
+    uint sum = lo + n;
+    if (sum < lo) hi += 1u;
+    lo = sum;
+}
 
 // Bindings of the renderer's set 0 after shared/scene_gpu.h's NB_BINDING_COUNT (20).
 #define NB_BIND_NEURAL_LEVELS 20u

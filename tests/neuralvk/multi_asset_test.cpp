@@ -325,10 +325,14 @@ TEST(MultiAsset, SettingsApplyWithoutRebuildMatchFreshRenderers) {
     EXPECT_EQ(d.data, fresh(deeper).data);
     EXPECT_EQ(c0.data, c1.data);
     EXPECT_NE(h.data, c0.data); // the hybrid image is not the classical one
+    // The leaf budget does not bound the wave (the query counter is 64-bit): any budget is an upload.
+    RenderOptions budget = o;
+    budget.neural.max_rounds = 256;
+    ASSERT_TRUE(live.apply(budget));
     RenderOptions bigger = o;
     bigger.width = 64;
     EXPECT_FALSE(live.apply(bigger));
-    EXPECT_EQ(live.live_updates(), 3u);
+    EXPECT_EQ(live.live_updates(), 4u);
     EXPECT_EQ(ctx.validation_message_count(), 0);
 }
 

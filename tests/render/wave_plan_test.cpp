@@ -49,8 +49,8 @@ void expect_within_limits(uint64_t pixels, const RenderOptions& o, const WaveLim
         const bool hybrid = o.neural.model != nullptr;
         const uint64_t k = o.neural.leaves_per_round;
         EXPECT_LE(2ull * NB_RAY_WORDS * 4 * cap, l.buffer_bytes);
-        // No 32-bit counter grows by 2^31 within one wave: rays by 2 per bounce, queries by the leaf budget.
-        EXPECT_LE(cap * 2 * o.max_depth * (hybrid ? o.neural.max_rounds : 1u), 1ull << 31);
+        // No 32-bit counter grows by 2^31 within one wave: rays by 2 per bounce (queries: 64-bit).
+        EXPECT_LE(cap * 2 * o.max_depth, 1ull << 31);
         const uint64_t bytes = 188 + (hybrid ? 2 * 64 + 2 * k * 52 : 0); // queues + neural state + pending pairs
         if (l.device_local_bytes) {
             EXPECT_LE(bytes * cap, l.device_local_bytes / 4);
@@ -138,16 +138,21 @@ TEST(WavePlan, MinimumWorkgroupCountBoundsEveryWave) {
     EXPECT_EQ(big.samples, 1u);
 }
 
-TEST(WavePlan, DeepPathsAndLargeLeafBudgetsKeepTheCountersFromWrapping) {
+// Deep paths shrink the wave so that no 32-bit ray counter can wrap; the leaf budget does not (the query
+// counter is 64-bit, GpuNeuralCounters): 256 leaves per ray keep the wave of 8 leaves.
+TEST(WavePlan, DeepPathsKeepTheRayCountersFromWrapping) {
     const NeuralModel model;
     RenderOptions o = opts(16, &model);
     o.max_depth = 256;
     o.neural.max_rounds = 256;
     const WavePlan p = plan_wave(P1080, o, h100());
-    EXPECT_EQ(p.capacity, (1ull << 31) / (2ull * 256 * 256));
-    EXPECT_EQ(p.samples, 1u);
-    // Each path adds at most 2 x 256 rays x 256 queries to the query counter: under 2^31 per wave.
-    EXPECT_LE(uint64_t(p.capacity) * 2 * 256 * 256, 1ull << 31);
+    EXPECT_EQ(p.samples, 2u); // 2^31 / (2 x 256) = 4.19M paths: two samples of 1080p
+    EXPECT_EQ(p.capacity, 2 * P1080);
+    // Each path adds at most 2 x 256 rays to a ray counter: under 2^31 per wave.
+    EXPECT_LE(uint64_t(p.capacity) * 2 * 256, 1ull << 31);
+    RenderOptions eight = o;
+    eight.neural.max_rounds = 8;
+    EXPECT_EQ(plan_wave(P1080, eight, h100()).capacity, p.capacity);
 }
 
 TEST(WavePlan, RandomOptionsAndLimitsStayWithinEveryBound) {
@@ -165,4 +170,19 @@ TEST(WavePlan, RandomOptionsAndLimitsStayWithinEveryBound) {
         expect_within_limits(pixels, o, l, p);
         if (HasFatalFailure() || HasNonfatalFailure()) break;
     }
+}
+
+// The 64-bit query counter's carry (shared/neural_gpu.h nb_add_u64, passes/neural_args.comp): sums past
+// 2^32 land in the high word, exactly as 64-bit arithmetic.
+TEST(WavePlan, QueryCounterCarriesIntoItsHighWord) {
+    std::mt19937_64 rng(11);
+    uint32_t lo = 0xFFFFFF00u, hi = 0;
+    uint64_t expect = lo;
+    for (int i = 0; i < 100000; ++i) {
+        const uint32_t n = i % 3 == 0 ? 0xFFFFFFFFu : uint32_t(rng() >> 40);
+        nb_add_u64(lo, hi, n);
+        expect += n;
+        ASSERT_EQ((uint64_t(hi) << 32) | lo, expect) << i;
+    }
+    EXPECT_GT(hi, 1000u);
 }
