@@ -28,7 +28,7 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
     cmd->add_option("--neural-leaves-per-round", o.neural.leaves_per_round,
                     "neural leaves a ray queues per traversal round (speculative ones included; same image)");
     cmd->add_option("--wave-pixels", o.max_wave_pixels,
-                    "paths traced per wave (rays per queue; several samples of each pixel while they fit in 16M paths, "
+                    "paths traced per wave (rays per queue; several samples of each pixel while they fit in 32M paths, "
                     "up to 16; also bounded by the device's buffer, memory and dispatch limits)")
         ->check(CLI::Range(64u, 1u << 26));
 }

@@ -193,15 +193,17 @@ void NeuralStage::install_model(std::vector<vk::Buffer>& buffers) {
 void NeuralStage::install(std::vector<vk::Buffer>& buffers) {
     install_model(buffers);
     // Two halves (ping-pong between a query round and the traversal that follows it) of
-    // leaves_per_round pairs per ray.
-    buffers[NB_BIND_PENDING_LEAVES] = vk::Buffer(ctx_, 2ull * params_.leaves_per_round * std::max(capacity_, 1u) * sizeof(GpuPendingLeaf),
-                                                 vk::MemoryKind::device, 0, "pending leaves");
+    // leaves_per_round pairs per ray, one binding each (lib/neural_bindings.glsl nb_pending_load).
+    const uint64_t half_bytes = uint64_t(params_.leaves_per_round) * std::max(capacity_, 1u) * sizeof(GpuPendingLeaf);
+    for (uint32_t b : {NB_BIND_PENDING_LEAVES, NB_BIND_PENDING_LEAVES_1}) {
+        buffers[b] = vk::Buffer(ctx_, half_bytes, vk::MemoryKind::device, 0, "pending leaves");
+        buffers[b].fill(0u);
+    }
     // Path rays at [0, capacity), shadow rays at [capacity, 2 capacity).
     buffers[NB_BIND_NEURAL_STATE] = vk::Buffer(ctx_, 2ull * std::max(capacity_, 1u) * sizeof(GpuNeuralRayState),
                                                vk::MemoryKind::device, 0, "neural ray state");
     buffers[NB_BIND_NEURAL_COUNTERS] =
         vk::Buffer(ctx_, sizeof(GpuNeuralCounters), vk::MemoryKind::device, 0, "neural counters");
-    buffers[NB_BIND_PENDING_LEAVES].fill(0u);
     buffers[NB_BIND_NEURAL_STATE].fill(0u);
     buffers[NB_BIND_NEURAL_COUNTERS].fill(0u);
 }

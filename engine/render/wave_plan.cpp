@@ -47,7 +47,7 @@ WavePlan plan_wave(uint64_t pixels, const RenderOptions& o, const WaveLimits& li
     if (o.neural.model) {
         const uint64_t k = effective_leaves_per_round(o.neural);
         cap = std::min<uint64_t>(cap, b / (2ull * sizeof(GpuNeuralRayState)));
-        cap = std::min<uint64_t>(cap, b / (2ull * k * sizeof(GpuPendingLeaf)));
+        cap = std::min<uint64_t>(cap, b / (k * sizeof(GpuPendingLeaf))); // each half of the pending queue
         // The query pass is dispatched indirectly over up to k pairs per ray (not checked on the host).
         if (limits.max_workgroups_x) cap = std::min<uint64_t>(cap, uint64_t(limits.max_workgroups_x) * NB_NEURAL_GROUP / k);
     }

@@ -25,8 +25,8 @@ struct WavePlan {
     uint32_t samples = 1;  // samples of every pixel per wave (1 when the image takes several waves)
 };
 
-// Paths of a wave of several samples, whatever --wave-pixels says (its default too: 8 samples of 1080p).
-constexpr uint64_t NB_WAVE_MAX_PATHS = 1u << 24;
+// Paths of a wave of several samples, whatever --wave-pixels says (its default too: 16 samples of 1080p).
+constexpr uint64_t NB_WAVE_MAX_PATHS = 1u << 25;
 constexpr uint32_t NB_WAVE_MAX_SAMPLES = 16;
 
 // Queue bytes per path: classical queues (two path-ray queues, hits, shadow rays, sample radiance),

@@ -34,10 +34,11 @@ struct RenderOptions {
     uint32_t rr_start_depth = 3;     // Russian roulette from this segment on
     // Paths per wave (rays per queue), further bounded by the device (one buffer's bytes, a quarter of
     // its memory, the dispatch limits) and the statistics counters; a wave of several samples of every
-    // pixel holds at most 16M paths (engine/render/wave_plan.h). 16M: eight samples of a 1080p frame, so
-    // the deep bounces' latency-bound passes are paid once per eight samples (results/perf/
-    // frame_depths.md). Queue memory at 16M: ~3.2 GB classical, ~8.8 GB hybrid (2 leaves per round).
-    uint32_t max_wave_pixels = 1u << 24;
+    // pixel holds at most 32M paths (engine/render/wave_plan.h). 32M: sixteen samples of a 1080p frame,
+    // so the deep bounces' latency-bound passes are paid once per sixteen samples (results/perf/
+    // frame_depths.md, README.md). Queue memory at 32M: ~6.2 GB classical, ~17.7 GB hybrid (2 leaves per
+    // round), bounded by a quarter of the GPU's memory.
+    uint32_t max_wave_pixels = 1u << 25;
     NeuralRenderOptions neural;      // hybrid (model) or classical-reference render of neural instances
     // Texel buffer or sampled-image array (texture_path.h): auto takes the array where the device can.
     TexturePathRequest texture_path = TexturePathRequest::automatic;

@@ -6,8 +6,9 @@
 # of each variant's image against the first variant's. Writes OUT/sweep.json and prints a table.
 # Usage (GPU machine, after `source .device/env.sh`):
 #   VARIANTS=$'base|\ntail3|--neural-tail-depth 3' scripts/bench/flag_sweep.sh OUT
-# Env: NBVH (binary, default .device/study/bin/nbvh), VARIANTS (lines NAME|FLAGS, hybrid flags; the
-#      classical render of each scene is always added as "classical"), REPS (default 2), SPP (16),
+# Env: NBVH (binary, default .device/study/bin/nbvh), VARIANTS (lines NAME|FLAGS: hybrid flags, or
+#      "classical FLAGS" for a classical variant; the classical render of each scene with no flags is
+#      always added as "classical"; FLIP compares each variant with the first), REPS (default 2), SPP (16),
 #      DRAGON (xz-packed glb, default .device/study/dragon/dragon_vrip.glb.xz), WIDTH, HEIGHT,
 #      TRAIN_ARGS (extra `nbvh train` flags, e.g. a short CPU training for a dry run).
 set -euo pipefail
@@ -34,7 +35,9 @@ for scene in default dragon; do
       name=${v%%|*}
       # shellcheck disable=SC2206
       F=(${v#*|})
-      "$B" render "${S[@]}" --model "$T/$scene.nbvh" "${F[@]}" "${R[@]}" --out "$T/${scene}_$name.png" \
+      M=(--model "$T/$scene.nbvh")
+      if [ "${F[0]:-}" = classical ]; then M=("${C[@]}"); F=("${F[@]:1}"); fi # a classical variant
+      "$B" render "${S[@]}" "${M[@]}" "${F[@]}" "${R[@]}" --out "$T/${scene}_$name.png" \
         --stats "$OUT/${scene}_${name}_$rep.json" > "$T/log" 2>&1 || { echo "FAIL $scene $name"; tail -2 "$T/log"; }
     done
   done

@@ -51,7 +51,11 @@ layout(set = 0, binding = NB_BIND_SHADOW_RAYS, scalar) buffer ShadowBuffer { uin
 layout(set = 0, binding = NB_BIND_SAMPLE_RADIANCE, scalar) buffer SampleRadianceBuffer { vec3 sample_radiance[]; };
 // Running sum over samples, per image pixel (rgb sum, a = samples accumulated).
 layout(set = 0, binding = NB_BIND_FILM, scalar) buffer FilmBuffer { vec4 film[]; };
+// The pending (ray, leaf) queue's two halves, one binding each (each may need most of one buffer's
+// range: a 32M-path hybrid wave holds 2 x 2 x 52 bytes of pairs per path); slots address both, half 1
+// from its half size on (lib/neural_bindings.glsl nb_nl_pending_index).
 layout(set = 0, binding = NB_BIND_PENDING_LEAVES, scalar) buffer PendingLeafBuffer { GpuPendingLeaf pending_leaves[]; };
+layout(set = 0, binding = NB_BIND_PENDING_LEAVES_1, scalar) buffer PendingLeafBuffer1 { GpuPendingLeaf pending_leaves_1[]; };
 layout(set = 0, binding = NB_BIND_OUTPUT, scalar) buffer OutputBuffer { vec4 output_pixels[]; };
 
 // ---- SOA accessors (layout: shared/wavefront_gpu.h) ----------------------------------------------

@@ -24,7 +24,52 @@ layout(set = 0, binding = NB_BIND_NEURAL_PARAMS, scalar) readonly buffer NeuralP
 layout(set = 0, binding = NB_BIND_NEURAL_ASSETS, scalar) readonly buffer NeuralAssetBuffer { GpuNeuralAsset neural_assets[]; };
 layout(set = 0, binding = NB_BIND_NEURAL_COUNTERS, scalar) coherent buffer NeuralCountersBuffer { GpuNeuralCounters neural_counters; };
 
-// Slot k of half `half_` of the pending queue (each half holds leaves_per_round pairs per ray).
-uint nb_nl_pending_index(uint half_, uint k) { return half_ * ray_capacity() * neural_params.leaves_per_round + k; }
+// Slot k of half `half_` of the pending queue (each half holds leaves_per_round pairs per ray, in its
+// own binding: half 1's slots start at the half size).
+uint nb_nl_half_size() { return ray_capacity() * neural_params.leaves_per_round; }
+uint nb_nl_pending_index(uint half_, uint k) { return half_ * nb_nl_half_size() + k; }
+// Whole records are copied field by field: glslang emits an invalid whole-struct store between the two
+// blocks' copies of the struct type (spirv-opt: "OpStore ... type does not match").
+#define NB_PENDING_COPY(DST, SRC)                                                                    \
+    DST.ray = SRC.ray;                                                                                \
+    DST.instance = SRC.instance;                                                                      \
+    DST.leaf = SRC.leaf;                                                                              \
+    DST.t_enter = SRC.t_enter;                                                                        \
+    DST.t_exit = SRC.t_exit;                                                                          \
+    DST.group = SRC.group;                                                                            \
+    DST.hit_t = SRC.hit_t;                                                                            \
+    DST.hit_normal = SRC.hit_normal;                                                                  \
+    DST.hit_albedo = SRC.hit_albedo;
+GpuPendingLeaf nb_pending_load(uint slot) {
+    uint hs = nb_nl_half_size();
+    GpuPendingLeaf pl;
+    if (slot < hs) {
+        NB_PENDING_COPY(pl, pending_leaves[slot])
+    } else {
+        NB_PENDING_COPY(pl, pending_leaves_1[slot - hs])
+    }
+    return pl;
+}
+void nb_pending_store(uint slot, GpuPendingLeaf pl) {
+    uint hs = nb_nl_half_size();
+    if (slot < hs) {
+        NB_PENDING_COPY(pending_leaves[slot], pl)
+    } else {
+        NB_PENDING_COPY(pending_leaves_1[slot - hs], pl)
+    }
+}
+// The query pass's result of a pair.
+void nb_pending_set_hit(uint slot, float t, vec3 normal, vec3 albedo) {
+    uint hs = nb_nl_half_size();
+    if (slot < hs) {
+        pending_leaves[slot].hit_t = t;
+        pending_leaves[slot].hit_normal = normal;
+        pending_leaves[slot].hit_albedo = albedo;
+    } else {
+        pending_leaves_1[slot - hs].hit_t = t;
+        pending_leaves_1[slot - hs].hit_normal = normal;
+        pending_leaves_1[slot - hs].hit_albedo = albedo;
+    }
+}
 
 #endif

@@ -30,7 +30,7 @@ NbPendingQuery nb_load_pending(uint k) {
     if (!r.valid) return r;
     uint cap = ray_capacity();
     r.slot = nb_nl_pending_index((pc.mode >> 2u) & 1u, k);
-    r.pl = pending_leaves[r.slot];
+    r.pl = nb_pending_load(r.slot);
     GpuInstance inst = instances[r.pl.instance];
     bool shadow = r.pl.ray >= cap;
     vec3 o = shadow ? shadow_load3(NB_SHADOW_ORIGIN, r.pl.ray - cap) : ray_load3(pc.in_queue, NB_RAY_ORIGIN, r.pl.ray);
@@ -67,9 +67,7 @@ float nb_neural_pair_hit(NbPendingQuery r, float y[NB_MLP_OUTPUTS], out vec3 nor
 void nb_apply_neural_result(NbPendingQuery r, float y[NB_MLP_OUTPUTS]) {
     vec3 normal, albedo;
     float t = nb_neural_pair_hit(r, y, normal, albedo);
-    pending_leaves[r.slot].hit_t = t;
-    pending_leaves[r.slot].hit_normal = normal;
-    pending_leaves[r.slot].hit_albedo = albedo;
+    nb_pending_set_hit(r.slot, t, normal, albedo);
 }
 
 #endif

@@ -131,7 +131,7 @@ bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, inout GpuN
         pl.hit_t = NB_INF;
         pl.hit_normal = vec3(0.0f, 0.0f, 1.0f);
         pl.hit_albedo = vec3(0.0f);
-        pending_leaves[nb_nl_pending_index(half_, k + j)] = pl;
+        nb_pending_store(nb_nl_pending_index(half_, k + j), pl);
     }
     st.key_t = g_nl_cand_t[n - 1u];
     st.key_instance = g_nl_cand_inst[n - 1u];
@@ -168,7 +168,7 @@ bool nb_nl_is_pending(uint status) { return status == NB_NRAY_PENDING || status 
 // The resumed traversal of a ray: the results of its `group` pairs from pending slot `slot` on.
 void nb_nl_reduce_group(uint slot, uint group, inout GpuNeuralRayState st) {
     for (uint j = 0u; j < group; ++j) {
-        GpuPendingLeaf pl = pending_leaves[slot + j];
+        GpuPendingLeaf pl = nb_pending_load(slot + j);
         nb_nl_take_hit(st, pl.hit_t, pl.hit_normal, pl.hit_albedo, pl.instance);
     }
     st.status = NB_NRAY_TRACE;

@@ -167,6 +167,7 @@ NB_STATIC_ASSERT(sizeof(GpuFrameParams) == 128, "GpuFrameParams layout");
 #define NB_BIND_SAMPLE_RADIANCE 16u
 #define NB_BIND_FILM 17u
 #define NB_BIND_PENDING_LEAVES 18u
+#define NB_BIND_PENDING_LEAVES_1 30u // its half 1 (after the neural bindings 20-29 of shared/neural_gpu.h)
 #define NB_BIND_OUTPUT 19u
 #define NB_BINDING_COUNT 20u
 

@@ -62,7 +62,7 @@ void expect_within_limits(uint64_t pixels, const RenderOptions& o, const WaveLim
             }
         }
         if (hybrid) {
-            EXPECT_LE(2ull * k * sizeof(GpuPendingLeaf) * cap, l.buffer_bytes);
+            EXPECT_LE(k * sizeof(GpuPendingLeaf) * cap, l.buffer_bytes); // each half of the pending queue
             EXPECT_LE(2ull * sizeof(GpuNeuralRayState) * cap, l.buffer_bytes);
         }
     }
@@ -70,12 +70,14 @@ void expect_within_limits(uint64_t pixels, const RenderOptions& o, const WaveLim
 
 } // namespace
 
-TEST(WavePlan, FullHdTakesEightSamplesPerWaveOnALargeGpu) {
+// 16 samples of 1080p in one wave, classical and hybrid (2 leaves per round: each half of the pending
+// queue 2 x 52 bytes x 33.2M = 3.45 GB, within one allocation; ~17.7 GB of queues, within a quarter of 80).
+TEST(WavePlan, FullHdTakesSixteenSamplesPerWaveOnALargeGpu) {
     const NeuralModel model;
     for (const NeuralModel* m : {static_cast<const NeuralModel*>(nullptr), &model}) {
         const WavePlan p = plan_wave(P1080, opts(16, m), h100());
-        EXPECT_EQ(p.samples, 8u) << (m ? "hybrid" : "classical");
-        EXPECT_EQ(p.capacity, 8 * P1080);
+        EXPECT_EQ(p.samples, 16u) << (m ? "hybrid" : "classical");
+        EXPECT_EQ(p.capacity, 16 * P1080);
         expect_within_limits(P1080, opts(16, m), h100(), p);
     }
 }
@@ -96,15 +98,15 @@ TEST(WavePlan, SmallImagesStopAtSixteenSamples) {
     EXPECT_GE(one.capacity, 64u);
 }
 
-// Four leaves per round at 1080p: 8 samples would need 2 x 4 x 52 bytes x 16.6M = 6.4 GiB of pending
-// pairs in one buffer; the wave shrinks to what 4094 MiB holds (it failed with a one-line allocation
+// Four leaves per round at 1080p: 16 samples would need 4 x 52 bytes x 33.2M = 6.4 GiB of pending pairs
+// in each half's buffer; the wave shrinks to what 4094 MiB holds (it failed with a one-line allocation
 // error before the plan knew the allocation limit).
 TEST(WavePlan, PendingPairsStayWithinOneAllocation) {
     const NeuralModel model;
     const WavePlan p = plan_wave(P1080, opts(16, &model, 4), h100());
-    EXPECT_EQ(p.samples, 4u); // 4094 MiB / 416 bytes = 10.3M paths: 4 samples, trimmed to them
-    EXPECT_EQ(p.capacity, 4 * P1080);
-    EXPECT_LE(2 * 4 * sizeof(GpuPendingLeaf) * p.capacity, 4094 * MIB);
+    EXPECT_EQ(p.samples, 9u); // 4094 MiB / 208 bytes = 20.6M paths: 9 samples, trimmed to them
+    EXPECT_EQ(p.capacity, 9 * P1080);
+    EXPECT_LE(4 * sizeof(GpuPendingLeaf) * p.capacity, 4094 * MIB);
     expect_within_limits(P1080, opts(16, &model, 4), h100(), p);
 }
 
