@@ -27,6 +27,11 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
                     "leaf rounds through the batched query pass before the per-ray tail pass");
     cmd->add_option("--neural-leaves-per-round", o.neural.leaves_per_round,
                     "neural leaves a ray queues per traversal round (speculative ones included; same image)");
+    cmd->add_option_function<std::string>(
+           "--sort-rays", [&o](const std::string& v) { o.sort_rays = v == "on"; },
+           "classical renders: trace secondary and shadow rays grouped by direction and origin (on, default) "
+           "or in queue order (off); same image")
+        ->check(CLI::IsMember({"on", "off"}));
     cmd->add_option("--wave-pixels", o.max_wave_pixels,
                     "paths traced per wave (rays per queue; several samples of each pixel while they fit in 32M paths, "
                     "up to 16; also bounded by the device's buffer, memory and dispatch limits)")

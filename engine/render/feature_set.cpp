@@ -160,12 +160,14 @@ std::vector<std::string> pass_list(const SceneFeatures& f, const NeuralPlan* neu
         neural_rounds(passes, *n, "passes/neural_traverse.comp");
         passes.push_back("passes/neural_traverse.comp"); // op 2: closest hit of triangles and neural leaves
     } else {
+        passes.push_back("passes/ray_sort.comp"); // secondary rays (RenderOptions::sort_rays)
         passes.push_back("passes/traverse.comp");
     }
     passes.push_back("passes/shade.comp");
     if (f.has_lights()) {
         passes.push_back("passes/queue_args.comp");
         if (n) neural_rounds(passes, *n, "passes/neural_shadow.comp");
+        else passes.push_back("passes/ray_sort.comp");
         passes.push_back("passes/shadow.comp");
     }
     passes.push_back("passes/accumulate.comp");
@@ -208,12 +210,14 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
         s += neural_rounds_text(*n, "passes/neural_traverse.comp", "closest hit through triangles and N-BVHs");
         s += "    passes/neural_traverse.comp  op 2: closest of triangle and accepted neural hits (indirect)\n";
     } else {
+        s += "    passes/ray_sort.comp       bounces > 0: rays in (direction octant, origin cell) order (--sort-rays)\n";
         s += "    passes/traverse.comp       TLAS/BLAS closest hit (indirect)\n";
     }
     s += "    passes/shade.comp          BSDF, emission, light sampling, next ray (indirect)\n";
     if (f.has_lights()) {
         s += "    passes/queue_args.comp     shadow counter -> indirect dispatch arguments\n";
         if (n) s += neural_rounds_text(*n, "passes/neural_shadow.comp", "visibility through N-BVHs");
+        else s += "    passes/ray_sort.comp       shadow rays in (direction octant, origin cell) order (--sort-rays)\n";
         s += "    passes/shadow.comp         any-hit visibility of light samples (indirect)\n";
     } else {
         s += "    (no shadow pass: nothing to sample by next-event estimation)\n";

@@ -21,7 +21,8 @@ WaveLimits wave_limits(const vk::DeviceFeatures& dev) {
 }
 
 uint64_t wave_bytes_per_path(const RenderOptions& o) {
-    const uint64_t classical = 4ull * (2 * NB_RAY_WORDS + NB_HIT_WORDS + NB_SHADOW_WORDS + 3);
+    // Two path-ray queues, hits, shadow rays, sample radiance (3), the two queues' ray order (2).
+    const uint64_t classical = 4ull * (2 * NB_RAY_WORDS + NB_HIT_WORDS + NB_SHADOW_WORDS + 3 + 2);
     return classical + (o.neural.model ? neural_scratch_bytes_per_ray(effective_leaves_per_round(o.neural)) : 0);
 }
 
@@ -51,7 +52,7 @@ WavePlan plan_wave(uint64_t pixels, const RenderOptions& o, const WaveLimits& li
         // The query pass is dispatched indirectly over up to k pairs per ray (not checked on the host).
         if (limits.max_workgroups_x) cap = std::min<uint64_t>(cap, uint64_t(limits.max_workgroups_x) * NB_NEURAL_GROUP / k);
     }
-    // The queues take at most a quarter of the GPU's memory (188 bytes per classical path, ~520 per
+    // The queues take at most a quarter of the GPU's memory (196 bytes per classical path, ~530 per
     // hybrid one with 2 leaves per round: an 8 GiB card holds ~11M / ~4M paths).
     if (limits.device_local_bytes)
         cap = std::min<uint64_t>(cap, limits.device_local_bytes / 4 / wave_bytes_per_path(o));

@@ -19,7 +19,7 @@ namespace nbvh::render {
 namespace {
 
 enum Pass : size_t {
-    CAMERA, QUEUE_ARGS, TRAVERSE, SHADE, SHADOW, ACCUMULATE, RESOLVE,
+    CAMERA, QUEUE_ARGS, TRAVERSE, SHADE, SHADOW, ACCUMULATE, RESOLVE, RAY_SORT,
     NEURAL_TRAVERSE, NEURAL_ARGS, NEURAL_QUERY, NEURAL_SHADOW, NEURAL_TAIL, // hybrid renders only (neural_stage.h)
     PASS_COUNT
 };
@@ -27,7 +27,8 @@ enum Pass : size_t {
 const char* const PASS_SHADERS[PASS_COUNT] = {"passes/camera_rays.comp", "passes/queue_args.comp",
                                               "passes/traverse.comp",    "passes/shade.comp",
                                               "passes/shadow.comp",      "passes/accumulate.comp",
-                                              "passes/resolve.comp",     "passes/neural_traverse.comp",
+                                              "passes/resolve.comp",     "passes/ray_sort.comp",
+                                              "passes/neural_traverse.comp",
                                               "passes/neural_args.comp", "passes/neural_query.comp",
                                               "passes/neural_shadow.comp", "passes/neural_tail.comp"};
 
@@ -119,6 +120,7 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     p.wave_capacity = capacity_;
     p.ray_epsilon = NB_RAY_EPSILON_SCALE * data_.scene_extent;
     p.instance_count = accel.tlas.prim_indices.empty() ? 0u : uint32_t(data_.instances.size());
+    p.sort_rays = options_.sort_rays && !hybrid_ ? 1u : 0u; // the hybrid's passes keep queue order
 
     // Buffers, indexed by binding.
     buffers_.resize(NB_BINDING_COUNT);
@@ -157,6 +159,16 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
         neural_->install(buffers_);
     }
     buffers_[NB_BIND_OUTPUT] = vk::Buffer(ctx_, pixels * sizeof(vec4), vk::MemoryKind::device, 0, "output");
+    // Ray order (NB_RS_*): zero bins, the world bounds the bins are cut from, the two queues' orders.
+    buffers_[NB_BIND_RAY_SORT] = vk::Buffer(ctx_, (uint64_t(NB_RS_HEADER_WORDS) + 2ull * capacity_) * 4,
+                                            vk::MemoryKind::device, 0, "ray sort");
+    buffers_[NB_BIND_RAY_SORT].fill(0u);
+    {
+        const Aabb wb = scene.world_bounds();
+        const glm::vec3 lo = wb.empty() ? glm::vec3(0.0f) : wb.lo, hi = wb.empty() ? glm::vec3(1.0f) : wb.hi;
+        const float bounds[8] = {lo.x, lo.y, lo.z, hi.x, hi.y, hi.z, 0.0f, 0.0f};
+        buffers_[NB_BIND_RAY_SORT].upload(bounds, sizeof(bounds), uint64_t(NB_RS_BOUNDS) * 4);
+    }
     for (uint32_t b : {NB_BIND_COUNTERS, NB_BIND_RAYS, NB_BIND_HITS, NB_BIND_SHADOW_RAYS, NB_BIND_SAMPLE_RADIANCE,
                        NB_BIND_FILM, NB_BIND_PENDING_LEAVES, NB_BIND_OUTPUT})
         buffers_[b].fill(0u);
@@ -258,6 +270,9 @@ bool WavefrontRenderer::apply(const RenderOptions& o) {
     params_.rr_start_depth = o.rr_start_depth;
     params_.seed = o.seed;
     params_.spp = o.spp;
+    options_.sort_rays = o.sort_rays;
+    const bool hybrid_next = neural_ ? !n.classical : hybrid_;
+    params_.sort_rays = o.sort_rays && !hybrid_next ? 1u : 0u;
     buffers_[NB_BIND_PARAMS].upload(&params_, sizeof(params_));
     if (neural_) {
         options_.neural = n;
@@ -338,14 +353,20 @@ void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, const Wave& w
             record_neural_rounds(cmd, NEURAL_TRAVERSE, q, depth, w);
             record_pass(cmd, NEURAL_TRAVERSE, constants(q, depth, w, 2), Dispatch::indirect_rays);
         } else {
-            record_pass(cmd, TRAVERSE, constants(q, depth, w, 0), Dispatch::indirect_rays);
+            // Camera rays keep pixel order; later bounces are traced in ray-sort order (NB_RS_*).
+            const bool sort = params_.sort_rays != 0 && depth > 0;
+            if (sort) record_pass(cmd, RAY_SORT, constants(q, depth, w, NB_ARGS_MODE_RAYS), Dispatch::indirect_rays);
+            record_pass(cmd, TRAVERSE, constants(q, depth, w, sort ? NB_TRAVERSE_MODE_SORTED : 0u), Dispatch::indirect_rays);
         }
         record_pass(cmd, SHADE, constants(q, depth, w, 0), Dispatch::indirect_rays);
         if (features_.has_lights()) {
             record_pass(cmd, QUEUE_ARGS, constants(q, depth, w, NB_ARGS_MODE_SHADOW),
                         Dispatch::single);
+            const bool sort = params_.sort_rays != 0;
             if (hybrid_) record_neural_rounds(cmd, NEURAL_SHADOW, q, depth, w);
-            record_pass(cmd, SHADOW, constants(q, depth, w, hybrid_ ? NB_SHADOW_MODE_HYBRID : 0u),
+            if (sort) record_pass(cmd, RAY_SORT, constants(q, depth, w, NB_ARGS_MODE_SHADOW), Dispatch::indirect_shadow);
+            record_pass(cmd, SHADOW,
+                        constants(q, depth, w, hybrid_ ? NB_SHADOW_MODE_HYBRID : (sort ? NB_SHADOW_MODE_SORTED : 0u)),
                         Dispatch::indirect_shadow);
         }
         q = 1 - q;

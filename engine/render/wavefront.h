@@ -36,9 +36,12 @@ struct RenderOptions {
     // its memory, the dispatch limits) and the statistics counters; a wave of several samples of every
     // pixel holds at most 32M paths (engine/render/wave_plan.h). 32M: sixteen samples of a 1080p frame,
     // so the deep bounces' latency-bound passes are paid once per sixteen samples (results/perf/
-    // frame_depths.md, README.md). Queue memory at 32M: ~6.2 GB classical, ~17.7 GB hybrid (2 leaves per
+    // frame_depths.md, README.md). Queue memory at 32M: ~6.5 GB classical, ~17.7 GB hybrid (2 leaves per
     // round), bounded by a quarter of the GPU's memory.
     uint32_t max_wave_pixels = 1u << 25;
+    // Classical renders trace secondary and shadow rays bin by bin of (direction octant, origin cell)
+    // (shared/wavefront_gpu.h NB_RS_*, passes/ray_sort.comp): same image, coherent warps. --sort-rays.
+    bool sort_rays = true;
     NeuralRenderOptions neural;      // hybrid (model) or classical-reference render of neural instances
     // Texel buffer or sampled-image array (texture_path.h): auto takes the array where the device can.
     TexturePathRequest texture_path = TexturePathRequest::automatic;

@@ -57,6 +57,11 @@ layout(set = 0, binding = NB_BIND_FILM, scalar) buffer FilmBuffer { vec4 film[];
 layout(set = 0, binding = NB_BIND_PENDING_LEAVES, scalar) buffer PendingLeafBuffer { GpuPendingLeaf pending_leaves[]; };
 layout(set = 0, binding = NB_BIND_PENDING_LEAVES_1, scalar) buffer PendingLeafBuffer1 { GpuPendingLeaf pending_leaves_1[]; };
 layout(set = 0, binding = NB_BIND_OUTPUT, scalar) buffer OutputBuffer { vec4 output_pixels[]; };
+// Ray order of the traversal and shadow passes (shared/wavefront_gpu.h NB_RS_*).
+layout(set = 0, binding = NB_BIND_RAY_SORT, std430) buffer RaySortBuffer {
+    uint rs_bins[NB_RS_HEADER_WORDS];
+    uint rs_order[];
+};
 
 // ---- SOA accessors (layout: shared/wavefront_gpu.h) ----------------------------------------------
 uint ray_capacity() { return params.wave_capacity; }
@@ -99,6 +104,14 @@ void shadow_store3(uint field, uint i, vec3 v) {
 uint shadow_load1(uint field, uint i) { return shadow_words[nb_shadow_word(field, ray_capacity(), i, 1u)]; }
 void shadow_store1(uint field, uint i, uint v) { shadow_words[nb_shadow_word(field, ray_capacity(), i, 1u)] = v; }
 
+// Ray-sort bin of a ray (shared/wavefront_gpu.h nb_rs_key) in the scene's bounds (the sort header).
+uint nb_rs_bin(vec3 o, vec3 d) {
+    vec3 lo = vec3(uintBitsToFloat(rs_bins[NB_RS_BOUNDS]), uintBitsToFloat(rs_bins[NB_RS_BOUNDS + 1u]),
+                   uintBitsToFloat(rs_bins[NB_RS_BOUNDS + 2u]));
+    vec3 hi = vec3(uintBitsToFloat(rs_bins[NB_RS_BOUNDS + 3u]), uintBitsToFloat(rs_bins[NB_RS_BOUNDS + 4u]),
+                   uintBitsToFloat(rs_bins[NB_RS_BOUNDS + 5u]));
+    return nb_rs_key(o, d, lo, hi);
+}
 uint queue_count(uint queue) { return queue == 0u ? counters.ray_count0 : counters.ray_count1; }
 
 // Affine transforms stored as three rows.

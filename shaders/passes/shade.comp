@@ -84,6 +84,7 @@ void main() {
                 vec3 contrib = throughput * f * le * (mis / light_pdf);
                 uint k = atomicAdd(counters.shadow_count, 1u);
                 vec3 o = ray_offset(s.p, s.ng);
+                if (params.sort_rays != 0u) atomicAdd(rs_bins[NB_RS_SHADOW_BINS + nb_rs_bin(o, wi)], 1u);
                 shadow_store3(NB_SHADOW_ORIGIN, k, o);
                 shadow_store3(NB_SHADOW_DIR, k, wi);
                 // Stop short of the light (its surface must not occlude itself).
@@ -111,7 +112,9 @@ void main() {
     uint out_q = 1u - q;
     uint k = out_q == 0u ? atomicAdd(counters.ray_count0, 1u) : atomicAdd(counters.ray_count1, 1u);
     vec3 n_side = dot(wi, s.ng) >= 0.0f ? s.ng : -s.ng; // transmission leaves through the back
-    ray_store3(out_q, NB_RAY_ORIGIN, k, ray_offset(s.p, n_side));
+    vec3 next_org = ray_offset(s.p, n_side);
+    if (params.sort_rays != 0u) atomicAdd(rs_bins[NB_RS_PATH_BINS(out_q) + nb_rs_bin(next_org, wi)], 1u);
+    ray_store3(out_q, NB_RAY_ORIGIN, k, next_org);
     ray_store3(out_q, NB_RAY_DIR, k, wi);
     ray_store3(out_q, NB_RAY_THROUGHPUT, k, throughput);
     ray_store1(out_q, NB_RAY_PIXEL, k, slot);

@@ -9,6 +9,7 @@ layout(local_size_x = NB_WAVEFRONT_GROUP) in;
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= counters.shadow_count) return;
+    if ((pc.mode & NB_SHADOW_MODE_SORTED) != 0u) i = rs_order[ray_capacity() + i]; // passes/ray_sort.comp
     vec3 org = shadow_load3(NB_SHADOW_ORIGIN, i);
     vec3 dir = shadow_load3(NB_SHADOW_DIR, i);
     float tmax = uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, i));

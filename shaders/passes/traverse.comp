@@ -10,6 +10,7 @@ void main() {
     uint i = gl_GlobalInvocationID.x;
     uint q = pc.in_queue;
     if (i >= queue_count(q)) return;
+    if ((pc.mode & NB_TRAVERSE_MODE_SORTED) != 0u) i = rs_order[i]; // passes/ray_sort.comp
     vec3 org = ray_load3(q, NB_RAY_ORIGIN, i);
     vec3 dir = ray_load3(q, NB_RAY_DIR, i);
     g_alpha_seed = ray_load1(q, NB_RAY_RNG, i);

@@ -183,6 +183,6 @@ NB_FN void nb_add_u64(NB_INOUT(uint) lo, NB_INOUT(uint) hi, uint n) {
 #define NB_BIND_NEURAL_COUNTERS 27u
 #define NB_BIND_NEURAL_MLP_T 28u    // the weights with each matrix transposed (cooperative-matrix pass)
 #define NB_BIND_NEURAL_ASSETS 29u   // GpuNeuralAsset[]
-#define NB_NEURAL_BINDING_END 31u    // 30: NB_BIND_PENDING_LEAVES_1 (shared/scene_gpu.h)
+#define NB_NEURAL_BINDING_END 32u    // 30, 31: NB_BIND_PENDING_LEAVES_1, NB_BIND_RAY_SORT (shared/scene_gpu.h)
 
 #endif

@@ -143,7 +143,7 @@ struct GpuFrameParams {
     uint instance_count;
     uint punctual_count;   // KHR_lights_punctual lights after the emissive triangles in the light array;
                            // their power cdf follows the emissive one in light_cdf (at light_count + 1)
-    uint pad1;
+    uint sort_rays;        // 1: shade.comp counts the rays it appends into the ray-sort bins (NB_RS_*)
 };
 NB_STATIC_ASSERT(sizeof(GpuFrameParams) == 128, "GpuFrameParams layout");
 
@@ -168,6 +168,7 @@ NB_STATIC_ASSERT(sizeof(GpuFrameParams) == 128, "GpuFrameParams layout");
 #define NB_BIND_FILM 17u
 #define NB_BIND_PENDING_LEAVES 18u
 #define NB_BIND_PENDING_LEAVES_1 30u // its half 1 (after the neural bindings 20-29 of shared/neural_gpu.h)
+#define NB_BIND_RAY_SORT 31u         // ray order of the traversal and shadow passes (shared/wavefront_gpu.h NB_RS_*)
 #define NB_BIND_OUTPUT 19u
 #define NB_BINDING_COUNT 20u
 

@@ -102,9 +102,39 @@ struct GpuQueueCounters {
 NB_STATIC_ASSERT(sizeof(GpuQueueCounters) == 68 + 8 * NB_STAT_DEPTHS, "GpuQueueCounters layout");
 // shadow.comp: the occlusion was decided by passes/neural_shadow.comp (hybrid renders).
 #define NB_SHADOW_MODE_HYBRID 1u
+#define NB_SHADOW_MODE_SORTED 2u // read shadow ray rs_order[capacity + k] (NB_RS_*)
+#define NB_TRAVERSE_MODE_SORTED 1u // traverse.comp: read path ray rs_order[k]
 #define NB_COUNTERS_RAY_DISPATCH_OFFSET 0u
 #define NB_COUNTERS_SHADOW_DISPATCH_OFFSET 12u
 #define NB_COUNTERS_PENDING_DISPATCH_OFFSET 24u
+
+// ---- Ray order of the classical traversal and shadow passes (RenderOptions::sort_rays) -------------
+// Secondary and shadow rays are incoherent; the traversal and shadow passes visit them bin by bin, bins
+// in Morton order of (direction octant, 8^3 cell of the origin in the scene's bounds), so that a warp's
+// rays walk the same BVH nodes. A counting sort per queue: shade.comp counts each ray it appends in its
+// queue's bins, queue_args.comp turns the counts into offsets (exclusive scan) and zeroes the bins the
+// next shade pass counts into, passes/ray_sort.comp scatters the ray indices, and the pass reads ray
+// order[k]. The order within a bin is whatever the atomics give; each ray's result goes to its own slot.
+#define NB_RS_BINS 4096u
+#define NB_RS_SCAN_THREADS 1024u
+// Sort binding layout (words): path-queue bins for queue 0 and 1, shadow bins, the scene's world bounds
+// (lo.xyz, hi.xyz as floats, written by the host), then the order of the path queue being traced
+// (capacity) and of the shadow queue (capacity).
+#define NB_RS_PATH_BINS(q) ((q) * NB_RS_BINS)
+#define NB_RS_SHADOW_BINS (2u * NB_RS_BINS)
+#define NB_RS_BOUNDS (3u * NB_RS_BINS)
+#define NB_RS_HEADER_WORDS (3u * NB_RS_BINS + 8u)
+// Spreads the low 3 bits of v to bits 0, 3, 6.
+NB_FN uint nb_rs_spread3(uint v) { return (v & 1u) | ((v & 2u) << 2u) | ((v & 4u) << 4u); }
+// Bin of a ray with origin o and direction d in a scene with bounds [lo, hi]: the direction octant in
+// the top 3 bits, the Morton code (x lowest) of the origin's cell of an 8^3 grid below.
+NB_FN uint nb_rs_key(vec3 o, vec3 d, vec3 lo, vec3 hi) {
+    vec3 ext = max(hi - lo, vec3(1e-30f));
+    vec3 f = (o - lo) / ext * 8.0f;
+    uint cx = uint(clamp(f.x, 0.0f, 7.0f)), cy = uint(clamp(f.y, 0.0f, 7.0f)), cz = uint(clamp(f.z, 0.0f, 7.0f));
+    uint oct = (d.x < 0.0f ? 1u : 0u) | (d.y < 0.0f ? 2u : 0u) | (d.z < 0.0f ? 4u : 0u);
+    return (oct << 9u) | nb_rs_spread3(cx) | (nb_rs_spread3(cy) << 1u) | (nb_rs_spread3(cz) << 2u);
+}
 
 // ---- Push constants (<= 128 bytes, the Vulkan minimum) --------------------------------------------
 #define NB_ARGS_MODE_RAYS 0u    // queue_args.comp: arguments for path-ray queue `in_queue`

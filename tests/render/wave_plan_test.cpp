@@ -51,7 +51,7 @@ void expect_within_limits(uint64_t pixels, const RenderOptions& o, const WaveLim
         EXPECT_LE(2ull * NB_RAY_WORDS * 4 * cap, l.buffer_bytes);
         // No 32-bit counter grows by 2^31 within one wave: rays by 2 per bounce (queries: 64-bit).
         EXPECT_LE(cap * 2 * o.max_depth, 1ull << 31);
-        const uint64_t bytes = 188 + (hybrid ? 2 * 64 + 2 * k * 52 : 0); // queues + neural state + pending pairs
+        const uint64_t bytes = 196 + (hybrid ? 2 * 64 + 2 * k * 52 : 0); // queues + ray order + neural state + pending pairs
         if (l.device_local_bytes) {
             EXPECT_LE(bytes * cap, l.device_local_bytes / 4);
         }
@@ -114,10 +114,10 @@ TEST(WavePlan, SmallGpusGetSmallerWaves) {
     const NeuralModel model;
     const WaveLimits card{4094 * MIB, 8 * GIB, 0x7FFFFFFFu};
     const WavePlan hybrid = plan_wave(P1080, opts(16, &model), card);
-    EXPECT_EQ(hybrid.samples, 1u); // 2 GiB / 524 bytes = 4.1M paths: one sample of 1080p
+    EXPECT_EQ(hybrid.samples, 1u); // 2 GiB / 532 bytes = 4.0M paths: one sample of 1080p
     EXPECT_EQ(hybrid.capacity, P1080);
     const WavePlan classical = plan_wave(P1080, opts(16), card);
-    EXPECT_EQ(classical.samples, 5u); // 2 GiB / 188 bytes = 11.4M paths
+    EXPECT_EQ(classical.samples, 5u); // 2 GiB / 196 bytes = 11.0M paths
     expect_within_limits(P1080, opts(16, &model), card, hybrid);
     expect_within_limits(P1080, opts(16), card, classical);
 }
