@@ -29,7 +29,7 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
                     "neural leaves a ray queues per traversal round (speculative ones included; same image)");
     cmd->add_option_function<std::string>(
            "--sort-rays", [&o](const std::string& v) { o.sort_rays = v == "on"; },
-           "classical renders: trace secondary and shadow rays grouped by direction and origin (on, default) "
+           "trace secondary and shadow rays grouped by direction and origin (on, default) "
            "or in queue order (off); same image")
         ->check(CLI::IsMember({"on", "off"}));
     cmd->add_option("--wave-pixels", o.max_wave_pixels,

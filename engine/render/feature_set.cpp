@@ -30,6 +30,7 @@ bool metallic_below_one(const Scene& scene, const Material& m) {
 
 std::string neural_rounds_text(const NeuralPlan& n, const char* traverse, const char* what) {
     std::string s;
+    s += "    passes/ray_sort.comp       rays in (direction octant, origin cell) order (--sort-rays; not camera rays)\n";
     s += strfmt("    %-26s op 0: %s, queues (ray, leaf) pairs (indirect)\n", traverse, what);
     if (n.batched_rounds > 0) {
         s += strfmt("    repeat %u x (batched rounds):\n", n.batched_rounds);
@@ -141,6 +142,7 @@ namespace {
 // The neural rounds of one traversal (WavefrontRenderer::record_neural_rounds): op 0 over every ray, then
 // per batched round the query of the queued pairs and the resumed traversal, then neural_tail.
 void neural_rounds(std::vector<std::string>& passes, const NeuralPlan& n, const char* traverse) {
+    passes.push_back("passes/ray_sort.comp"); // bounces > 0 and shadow rays (RenderOptions::sort_rays)
     passes.push_back(traverse);
     for (uint32_t r = 0; r < n.batched_rounds; ++r) {
         passes.push_back("passes/neural_args.comp");

@@ -120,7 +120,7 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     p.wave_capacity = capacity_;
     p.ray_epsilon = NB_RAY_EPSILON_SCALE * data_.scene_extent;
     p.instance_count = accel.tlas.prim_indices.empty() ? 0u : uint32_t(data_.instances.size());
-    p.sort_rays = options_.sort_rays && !hybrid_ ? 1u : 0u; // the hybrid's passes keep queue order
+    p.sort_rays = options_.sort_rays ? 1u : 0u;
 
     // Buffers, indexed by binding.
     buffers_.resize(NB_BINDING_COUNT);
@@ -271,8 +271,7 @@ bool WavefrontRenderer::apply(const RenderOptions& o) {
     params_.seed = o.seed;
     params_.spp = o.spp;
     options_.sort_rays = o.sort_rays;
-    const bool hybrid_next = neural_ ? !n.classical : hybrid_;
-    params_.sort_rays = o.sort_rays && !hybrid_next ? 1u : 0u;
+    params_.sort_rays = o.sort_rays ? 1u : 0u;
     buffers_[NB_BIND_PARAMS].upload(&params_, sizeof(params_));
     if (neural_) {
         options_.neural = n;
@@ -328,8 +327,12 @@ void WavefrontRenderer::record_pass(vk::CommandBuffer& cmd, size_t pass, const G
 // the pairs). Round r queries pending half r & 1; the traversal after it queues into the other half.
 void WavefrontRenderer::record_neural_rounds(vk::CommandBuffer& cmd, size_t traverse_pass, uint32_t q, uint32_t depth,
                                              const Wave& w) {
-    const Dispatch all = traverse_pass == NEURAL_SHADOW ? Dispatch::indirect_shadow : Dispatch::indirect_rays;
-    record_pass(cmd, traverse_pass, constants(q, depth, w, 0), all);
+    const bool shadow = traverse_pass == NEURAL_SHADOW;
+    const Dispatch all = shadow ? Dispatch::indirect_shadow : Dispatch::indirect_rays;
+    // Op 0 over every ray: camera rays in pixel order, later bounces and shadow rays in ray-sort order.
+    const bool sort = params_.sort_rays != 0 && (shadow || depth > 0);
+    if (sort) record_pass(cmd, RAY_SORT, constants(q, depth, w, shadow ? NB_ARGS_MODE_SHADOW : NB_ARGS_MODE_RAYS), all);
+    record_pass(cmd, traverse_pass, constants(q, depth, w, sort ? NB_NL_MODE_SORTED : 0u), all);
     const uint32_t batched = neural_->batched_rounds();
     for (uint32_t round = 0; round < batched; ++round) {
         const uint32_t half = round & 1u;
@@ -362,7 +365,7 @@ void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, const Wave& w
         if (features_.has_lights()) {
             record_pass(cmd, QUEUE_ARGS, constants(q, depth, w, NB_ARGS_MODE_SHADOW),
                         Dispatch::single);
-            const bool sort = params_.sort_rays != 0;
+            const bool sort = params_.sort_rays != 0 && !hybrid_; // the hybrid's neural_shadow op 0 sorts
             if (hybrid_) record_neural_rounds(cmd, NEURAL_SHADOW, q, depth, w);
             if (sort) record_pass(cmd, RAY_SORT, constants(q, depth, w, NB_ARGS_MODE_SHADOW), Dispatch::indirect_shadow);
             record_pass(cmd, SHADOW,

@@ -39,8 +39,9 @@ struct RenderOptions {
     // frame_depths.md, README.md). Queue memory at 32M: ~6.5 GB classical, ~17.7 GB hybrid (2 leaves per
     // round), bounded by a quarter of the GPU's memory.
     uint32_t max_wave_pixels = 1u << 25;
-    // Classical renders trace secondary and shadow rays bin by bin of (direction octant, origin cell)
-    // (shared/wavefront_gpu.h NB_RS_*, passes/ray_sort.comp): same image, coherent warps. --sort-rays.
+    // Secondary and shadow rays are traced bin by bin of (direction octant, origin cell) (shared/
+    // wavefront_gpu.h NB_RS_*, passes/ray_sort.comp; the hybrid's neural traversal op 0 too): same image,
+    // coherent warps. --sort-rays.
     bool sort_rays = true;
     NeuralRenderOptions neural;      // hybrid (model) or classical-reference render of neural instances
     // Texel buffer or sampled-image array (texture_path.h): auto takes the array where the device can.

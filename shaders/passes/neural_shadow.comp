@@ -40,6 +40,7 @@ void main() {
     } else {
         i = gl_GlobalInvocationID.x;
         if (i >= counters.shadow_count) return;
+        if ((pc.mode & NB_NL_MODE_SORTED) != 0u) i = rs_order[cap + i]; // passes/ray_sort.comp
         st = nb_nl_fresh_state();
     }
     vec3 org = shadow_load3(NB_SHADOW_ORIGIN, i);

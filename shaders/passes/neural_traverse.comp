@@ -42,6 +42,7 @@ void main() {
     } else {
         i = gl_GlobalInvocationID.x;
         if (i >= queue_count(q)) return;
+        if (op == 0u && (pc.mode & NB_NL_MODE_SORTED) != 0u) i = rs_order[i]; // passes/ray_sort.comp
         if (op == 2u) {
             if (i == 0u) counters.pending_count = 0u; // nothing queued remains for the shadow loop
             st = neural_state[i];

@@ -99,6 +99,9 @@ NB_FN void nb_neural_cull_bounds(NB_INOUT(vec3) lo, NB_INOUT(vec3) hi) {
 // Leaves a ray may queue per round (the next ones in key order in front of its best hit): one
 // traversal and one query round serve several leaf visits; the pending queue holds that many pairs per ray.
 #define NB_NL_MAX_LEAVES_PER_ROUND 4u
+// Pass-constant bit of op 0 of passes/neural_traverse.comp and neural_shadow.comp: the rays in ray-sort
+// order (shared/wavefront_gpu.h NB_RS_*, passes/ray_sort.comp); bits 0-1 are the op, bit 2 the half.
+#define NB_NL_MODE_SORTED 8u
 #define NB_NRAY_TRACE 0u    // needs a traversal round
 #define NB_NRAY_PENDING 1u  // a (ray, leaf) pair is queued
 #define NB_NRAY_DONE 2u

@@ -44,7 +44,8 @@ struct Rendered {
 Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPath::scalar, float threshold = 0.5f,
                       uint32_t lod = 0, int32_t secondary_lod = -1, uint32_t batched_rounds = 256,
                       uint32_t leaves_per_round = NeuralRenderOptions{}.leaves_per_round,
-                      uint32_t max_leaves = NeuralRenderOptions{}.max_rounds) {
+                      uint32_t max_leaves = NeuralRenderOptions{}.max_rounds,
+                      bool sort_rays = RenderOptions{}.sort_rays) {
     vk::ContextOptions co;
     co.device = vk::DeviceChoice::cpu;
     co.validation = true;
@@ -66,6 +67,7 @@ Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPat
     o.neural.batched_rounds = batched_rounds;
     o.neural.leaves_per_round = leaves_per_round;
     o.neural.max_rounds = max_leaves;
+    o.sort_rays = sort_rays;
     if (hybrid) o.neural.model = &f.model;
     else o.neural.classical = true;
     WavefrontRenderer r(ctx, f.scene, accel, default_sky(), cam, o);
@@ -188,6 +190,26 @@ TEST(HybridRender, LeavesPerRoundKeepTheImage) {
     EXPECT_GE(k2.stats.neural_queries, k1.stats.neural_queries);
     EXPECT_GE(k4.stats.neural_queries, k2.stats.neural_queries);
     EXPECT_LT(k4.stats.neural_rounds, k1.stats.neural_rounds);
+}
+
+// The ray order (--sort-rays) in a hybrid render: the neural traversal's op 0 and the neural shadow rays
+// take the rays in ray-sort order; the image and the queries stay those of queue order, with one leaf per
+// round and with several, with and without the tail pass.
+TEST(HybridRender, SortedRaysKeepTheImage) {
+    NBVH_REQUIRE_SHARED();
+    const Fixture& f = trained_bunny();
+    for (uint32_t k : {1u, 2u})
+        for (uint32_t batched : {256u, 1u}) {
+            const Rendered plain = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, 1, batched, k, 8, false);
+            const Rendered sorted = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, 1, batched, k, 8, true);
+            EXPECT_EQ(plain.validation + sorted.validation, 0);
+            std::printf("%u leaves per round, %u batched rounds: queries %llu / %llu (queue order / sorted)\n", k, batched,
+                        (unsigned long long)plain.stats.neural_queries, (unsigned long long)sorted.stats.neural_queries);
+            EXPECT_GT(sorted.stats.neural_queries, 0u);
+            EXPECT_EQ(plain.stats.neural_queries, sorted.stats.neural_queries);
+            EXPECT_EQ(plain.stats.rays_shadow, sorted.stats.rays_shadow);
+            EXPECT_EQ(plain.image.data, sorted.image.data);
+        }
 }
 
 TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
