@@ -80,7 +80,7 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
 std::vector<vk::SpecConstant> specialization(const SceneFeatures& features);
 
 // The passes that one sample wave runs, in order (file names under shaders/), e.g.
-// camera_rays, [queue_args, traverse, shade, (queue_args, shadow)] x max_depth, accumulate; resolve;
+// camera_rays, [queue_args, ray_sort, traverse, shade, (queue_args, ray_sort, shadow)] x max_depth, accumulate; resolve;
 // one bounce listed. Hybrid renders (`neural`) traverse through the neural rounds (neural_stage.h).
 std::vector<std::string> pass_list(const SceneFeatures& features, const NeuralPlan* neural = nullptr);
 

@@ -1,7 +1,7 @@
 // The wavefront path tracer: owns the scene buffers, the per-ray SOA queues and one compute pipeline
 // per stage, and records the pass sequence (README.md here):
-//   camera_rays -> [queue_args -> traverse -> shade -> (queue_args -> shadow)] x max_depth -> accumulate
-//   ... per sample and wave of pixels, then resolve once.
+//   camera_rays -> [queue_args -> (ray_sort) -> traverse -> shade -> (queue_args -> ray_sort -> shadow)] x max_depth
+//   -> accumulate ... per sample and wave of pixels, then resolve once (ray_sort: --sort-rays, not camera rays).
 // The Vulkan context owns device things; the Scene/SceneAccel stay with the caller.
 #pragma once
 #include <cstdint>

@@ -14,10 +14,10 @@ void main() {
         uint q = pc.in_queue;
         if (k >= queue_count(q)) return;
         uint pos = atomicAdd(rs_bins[NB_RS_PATH_BINS(q) + nb_rs_bin(ray_load3(q, NB_RAY_ORIGIN, k), ray_load3(q, NB_RAY_DIR, k))], 1u);
-        rs_order[pos] = k;
+        if (pos < queue_count(q)) rs_order[pos] = k; // always (shade counted the same keys); memory-safe
     } else {
         if (k >= counters.shadow_count) return;
         uint pos = atomicAdd(rs_bins[NB_RS_SHADOW_BINS + nb_rs_bin(shadow_load3(NB_SHADOW_ORIGIN, k), shadow_load3(NB_SHADOW_DIR, k))], 1u);
-        rs_order[ray_capacity() + pos] = k;
+        if (pos < counters.shadow_count) rs_order[ray_capacity() + pos] = k;
     }
 }

@@ -116,7 +116,7 @@ NB_STATIC_ASSERT(sizeof(GpuQueueCounters) == 68 + 8 * NB_STAT_DEPTHS, "GpuQueueC
 // next shade pass counts into, passes/ray_sort.comp scatters the ray indices, and the pass reads ray
 // order[k]. The order within a bin is whatever the atomics give; each ray's result goes to its own slot.
 #define NB_RS_BINS 4096u
-#define NB_RS_SCAN_THREADS 1024u
+#define NB_RS_SCAN_THREADS 128u // queue_args.comp's workgroup: Vulkan's guaranteed minimum size
 // Sort binding layout (words): path-queue bins for queue 0 and 1, shadow bins, the scene's world bounds
 // (lo.xyz, hi.xyz as floats, written by the host), then the order of the path queue being traced
 // (capacity) and of the shadow queue (capacity).
@@ -131,7 +131,10 @@ NB_FN uint nb_rs_spread3(uint v) { return (v & 1u) | ((v & 2u) << 2u) | ((v & 4u
 NB_FN uint nb_rs_key(vec3 o, vec3 d, vec3 lo, vec3 hi) {
     vec3 ext = max(hi - lo, vec3(1e-30f));
     vec3 f = (o - lo) / ext * 8.0f;
-    uint cx = uint(clamp(f.x, 0.0f, 7.0f)), cy = uint(clamp(f.y, 0.0f, 7.0f)), cz = uint(clamp(f.z, 0.0f, 7.0f));
+    // NaN-safe clamps (a NaN coordinate goes to cell 0: defined, and the same in every pass).
+    uint cx = uint(f.x >= 0.0f ? min(f.x, 7.0f) : 0.0f);
+    uint cy = uint(f.y >= 0.0f ? min(f.y, 7.0f) : 0.0f);
+    uint cz = uint(f.z >= 0.0f ? min(f.z, 7.0f) : 0.0f);
     uint oct = (d.x < 0.0f ? 1u : 0u) | (d.y < 0.0f ? 2u : 0u) | (d.z < 0.0f ? 4u : 0u);
     return (oct << 9u) | nb_rs_spread3(cx) | (nb_rs_spread3(cy) << 1u) | (nb_rs_spread3(cz) << 2u);
 }
