@@ -329,9 +329,7 @@ void WavefrontRenderer::record_neural_rounds(vk::CommandBuffer& cmd, size_t trav
                                              const Wave& w) {
     const bool shadow = traverse_pass == NEURAL_SHADOW;
     const Dispatch all = shadow ? Dispatch::indirect_shadow : Dispatch::indirect_rays;
-    // Op 0 over every ray: camera rays in pixel order, later bounces and shadow rays in ray-sort order.
-    const bool sort = params_.sort_rays != 0 && (shadow || depth > 0);
-    if (sort) record_pass(cmd, RAY_SORT, constants(q, depth, w, shadow ? NB_ARGS_MODE_SHADOW : NB_ARGS_MODE_RAYS), all);
+    const bool sort = record_ray_sort(cmd, q, depth, w, shadow); // op 0 reads the ray order
     record_pass(cmd, traverse_pass, constants(q, depth, w, sort ? NB_NL_MODE_SORTED : 0u), all);
     const uint32_t batched = neural_->batched_rounds();
     for (uint32_t round = 0; round < batched; ++round) {
@@ -346,6 +344,13 @@ void WavefrontRenderer::record_neural_rounds(vk::CommandBuffer& cmd, size_t trav
     record_pass(cmd, NEURAL_TAIL, constants(q, depth, w, (batched & 1u) << 2), Dispatch::indirect_pending);
 }
 
+bool WavefrontRenderer::record_ray_sort(vk::CommandBuffer& cmd, uint32_t q, uint32_t depth, const Wave& w, bool shadow) {
+    if (params_.sort_rays == 0 || (!shadow && depth == 0)) return false; // camera rays keep pixel order
+    record_pass(cmd, RAY_SORT, constants(q, depth, w, shadow ? NB_ARGS_MODE_SHADOW : NB_ARGS_MODE_RAYS),
+                shadow ? Dispatch::indirect_shadow : Dispatch::indirect_rays);
+    return true;
+}
+
 void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, const Wave& w) {
     record_pass(cmd, CAMERA, constants(0, 0, w, 0), Dispatch::items, uint64_t(w.count) * w.samples);
     uint32_t q = 0;
@@ -356,18 +361,16 @@ void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, const Wave& w
             record_neural_rounds(cmd, NEURAL_TRAVERSE, q, depth, w);
             record_pass(cmd, NEURAL_TRAVERSE, constants(q, depth, w, 2), Dispatch::indirect_rays);
         } else {
-            // Camera rays keep pixel order; later bounces are traced in ray-sort order (NB_RS_*).
-            const bool sort = params_.sort_rays != 0 && depth > 0;
-            if (sort) record_pass(cmd, RAY_SORT, constants(q, depth, w, NB_ARGS_MODE_RAYS), Dispatch::indirect_rays);
+            const bool sort = record_ray_sort(cmd, q, depth, w, false);
             record_pass(cmd, TRAVERSE, constants(q, depth, w, sort ? NB_TRAVERSE_MODE_SORTED : 0u), Dispatch::indirect_rays);
         }
         record_pass(cmd, SHADE, constants(q, depth, w, 0), Dispatch::indirect_rays);
         if (features_.has_lights()) {
             record_pass(cmd, QUEUE_ARGS, constants(q, depth, w, NB_ARGS_MODE_SHADOW),
                         Dispatch::single);
-            const bool sort = params_.sort_rays != 0 && !hybrid_; // the hybrid's neural_shadow op 0 sorts
+            // Hybrid: neural_shadow's op 0 reads the order and decides; shadow.comp only applies it.
+            const bool sort = !hybrid_ && record_ray_sort(cmd, q, depth, w, true);
             if (hybrid_) record_neural_rounds(cmd, NEURAL_SHADOW, q, depth, w);
-            if (sort) record_pass(cmd, RAY_SORT, constants(q, depth, w, NB_ARGS_MODE_SHADOW), Dispatch::indirect_shadow);
             record_pass(cmd, SHADOW,
                         constants(q, depth, w, hybrid_ ? NB_SHADOW_MODE_HYBRID : (sort ? NB_SHADOW_MODE_SORTED : 0u)),
                         Dispatch::indirect_shadow);

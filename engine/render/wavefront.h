@@ -160,6 +160,9 @@ private:
                      uint64_t items = 0);
     void record_sample_wave(vk::CommandBuffer& cmd, const Wave& w);
     void record_neural_rounds(vk::CommandBuffer& cmd, size_t traverse_pass, uint32_t q, uint32_t depth, const Wave& w);
+    // Records passes/ray_sort.comp for the path queue q (not camera rays) or the shadow queue when the
+    // ray order is on; returns whether the traversal that follows reads the order.
+    bool record_ray_sort(vk::CommandBuffer& cmd, uint32_t q, uint32_t depth, const Wave& w, bool shadow);
     // Samples [first, first + count) into the film (cleared when first == 0), then resolve + read back.
     RenderResult render_samples(uint32_t first, uint32_t count, bool read_back = true);
 
