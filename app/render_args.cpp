@@ -28,6 +28,11 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
     cmd->add_option("--neural-leaves-per-round", o.neural.leaves_per_round,
                     "neural leaves a ray queues per traversal round (speculative ones included; same image)");
     cmd->add_option_function<std::string>(
+           "--neural-occupancy", [&o](const std::string& v) { o.neural.occupancy = v == "on"; },
+           "skip neural leaves whose ray segment crosses only empty cells of the model's occupancy masks "
+           "(on, default; models without masks query every leaf) or query every leaf (off)")
+        ->check(CLI::IsMember({"on", "off"}));
+    cmd->add_option_function<std::string>(
            "--sort-rays", [&o](const std::string& v) { o.sort_rays = v == "on"; },
            "trace secondary and shadow rays grouped by direction and origin (on, default) "
            "or in queue order (off); same image")

@@ -1,9 +1,12 @@
 #include "trainer/model_export.h"
 
+#include <chrono>
 #include <ctime>
 
 #include "engine/core/error.h"
+#include "engine/core/log.h"
 #include "engine/neural/asset_table.h"
+#include "engine/neural/occupancy.h"
 
 namespace nbvh {
 
@@ -29,6 +32,13 @@ NeuralModel make_neural_model(const TrainingAsset& asset, const TrainResult& res
     }
     m.mlp = neural::mlp_to_fp16(result.weights);
     m.grid = neural::grid_to_fp16(result.weights);
+    if (asset.mesh) { // node boxes and mesh: atlas space
+        const auto t0 = std::chrono::steady_clock::now();
+        m.occupancy = build_occupancy(m.nodes, *asset.mesh);
+        log_info("occupancy masks: %.0f ms, %.1f %% of the LoD-0 leaves' cells occupied (%zu KiB)",
+                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count(),
+                 100.0 * occupancy_fraction(m.nodes, m.occupancy, 0), m.occupancy.size() * 4 / 1024);
+    }
     TrainingMetadata& meta = m.meta;
     meta.steps = result.log.size();
     meta.final_loss = result.log.empty() ? 0.0f : float(result.log.back().loss.total);

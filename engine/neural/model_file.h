@@ -19,7 +19,7 @@
 
 namespace nbvh {
 
-inline constexpr uint32_t MODEL_FORMAT_VERSION = 2;     // written; version 1 (one unnamed asset) still reads
+inline constexpr uint32_t MODEL_FORMAT_VERSION = 3; // written; versions 1 (one unnamed asset) and 2 (no OCCU) still read
 inline constexpr uint32_t MODEL_MAX_ASSETS = 65536;
 inline constexpr size_t MODEL_MAX_STRING = 4096; // bytes of a name in the file
 
@@ -65,6 +65,9 @@ struct NeuralModel {
     std::vector<uint32_t> lod_node_counts; // nodes reached walking LoD l (index l), lod_count entries
     std::vector<uint16_t> mlp;           // fp16 bits, NB_MLP_WEIGHT_COUNT (shaders/shared/mlp.h order)
     std::vector<uint16_t> grid;          // fp16 bits, level_table_entries(levels) * grid_features
+    // Occupancy masks (engine/neural/occupancy.h): NB_OCC_WORDS per node, or empty (files before
+    // version 3, or models built without the triangles): every leaf is then queried.
+    std::vector<uint32_t> occupancy;
     TrainingMetadata meta;
 
     // The tree (parent/depth derived). The nodes must be valid (they are after load_model).
@@ -89,7 +92,7 @@ NeuralModel parse_model(std::span<const uint8_t> bytes, const std::string& name 
 NeuralModel load_model(const std::filesystem::path& path);
 
 // Memory of the neural part as the renderer holds it (nodes as GpuBvhNode of LoD 0, fp16 weights and
-// grid, level table), in bytes.
+// grid, level table, occupancy masks), in bytes.
 uint64_t model_gpu_bytes(const NeuralModel& model);
 
 // The classical representation of a mesh as the renderer holds it: positions, normals and one UV set

@@ -6,6 +6,7 @@
 
 #include "engine/core/log.h"
 #include "engine/neural/level_table.h"
+#include "shaders/shared/neural_occupancy.h"
 #include "shaders/shared/mlp.h"
 
 namespace nbvh::model_io {
@@ -20,7 +21,8 @@ constexpr char ID_NODES[4] = {'N', 'O', 'D', 'E'};
 constexpr char ID_MLP[4] = {'M', 'L', 'P', ' '};
 constexpr char ID_GRID[4] = {'G', 'R', 'I', 'D'};
 constexpr char ID_META[4] = {'M', 'E', 'T', 'A'};
-constexpr const char* ALL_IDS[] = {ID_CONF, ID_ASSET, ID_LEVELS, ID_LODS, ID_NODES, ID_MLP, ID_GRID, ID_META};
+constexpr char ID_OCC[4] = {'O', 'C', 'C', 'U'}; // optional, version 3
+constexpr const char* ALL_IDS[] = {ID_CONF, ID_ASSET, ID_LEVELS, ID_LODS, ID_NODES, ID_MLP, ID_GRID, ID_META, ID_OCC};
 
 constexpr uint8_t NODE_FLAG_FINAL = 1;
 
@@ -219,6 +221,14 @@ std::vector<Section> encode_sections(const NeuralModel& m) {
         w.str(t.backend);
         w.str(t.source);
         out.push_back(make(ID_META, std::move(b)));
+    }
+    if (!m.occupancy.empty()) {
+        b.clear();
+        Writer w(b);
+        w.u32(uint32_t(m.nodes.size()));
+        w.u32(NB_OCC_WORDS);
+        for (uint32_t v : m.occupancy) w.u32(v);
+        out.push_back(make(ID_OCC, std::move(b)));
     }
     return out;
 }
@@ -426,6 +436,20 @@ NeuralModel decode_sections(const std::vector<SectionView>& sections, const std:
         if (!std::isfinite(t.seconds) || t.seconds < 0.0 || !std::isfinite(t.final_loss) ||
             !std::isfinite(t.split_scaling) || !std::isfinite(t.split_interval_scaling))
             throw Error(r.where() + ": training metadata holds a non-finite or negative number");
+    }
+    for (const SectionView& s : sections) {
+        if (std::memcmp(s.id, ID_OCC, 4) != 0) continue;
+        Reader r(s.bytes, name + ": section 'OCCU'");
+        if (version < 3) throw Error(r.where() + ": occupancy masks need format version 3");
+        const uint32_t count = r.u32(), words = r.u32();
+        if (count != m.nodes.size() || words != NB_OCC_WORDS)
+            throw Error(strfmt("%s: %u nodes x %u words, the model has %zu nodes x %u", r.where().c_str(), count, words,
+                               m.nodes.size(), NB_OCC_WORDS));
+        if (r.remaining() != size_t(count) * words * 4)
+            throw Error(r.where() + ": size does not match its node count");
+        m.occupancy.resize(size_t(count) * words);
+        for (uint32_t& v : m.occupancy) v = r.u32();
+        expect_end(r);
     }
     validate_assets(m, name);
     return m;

@@ -1,9 +1,11 @@
 #include "engine/render/neural_model_gpu.h"
 
 #include <algorithm>
+#include <cstring>
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
+#include "shaders/shared/neural_occupancy.h"
 #include "engine/vk/commands.h"
 #include "shaders/shared/mlp.h"
 
@@ -145,7 +147,15 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
         bounds.push_back(n.bounds.lo);
         bounds.push_back(n.bounds.hi);
     }
-    leaf_bounds_ = vk::make_buffer(ctx, bounds, "nbvh node bounds");
+    // The occupancy masks (shared/neural_occupancy.h) follow the bounds in the same buffer (the set has
+    // no binding to spare: lavapipe allows 32 storage buffers per stage); models without masks have none.
+    std::vector<uint32_t> words(bounds.size() * 3);
+    std::memcpy(words.data(), bounds.data(), words.size() * 4);
+    if (model.occupancy.size() == model.nodes.size() * NB_OCC_WORDS) {
+        occupancy_offset_ = uint32_t(words.size());
+        words.insert(words.end(), model.occupancy.begin(), model.occupancy.end());
+    }
+    leaf_bounds_ = vk::make_buffer(ctx, words, "nbvh node bounds and occupancy");
     box_ = encoding_box_of(model);
     bytes_ = levels_.size() + grid_.size() + mlp_.size() + mlp_t_.size() + nodes_.size() + leaf_bounds_.size();
 }

@@ -170,6 +170,7 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     params_.metallic = o.metallic < 0.0f ? -1.0f : o.metallic;
     params_.threshold = o.threshold;
     params_.max_rounds = o.max_rounds;
+    params_.occupancy = o.occupancy ? model_.occupancy_offset() : 0u;
 }
 
 void NeuralStage::update(const NeuralRenderOptions& o, vk::Buffer& params_buffer) {

@@ -57,6 +57,9 @@ struct NeuralRenderOptions {
     // scene 7.03 -> 6.62 ms per sample, dragon 3.89 -> 3.48 with the 16M-path waves, same images).
     uint32_t leaves_per_round = 2;
     float threshold = NB_VISIBILITY_THRESHOLD;
+    // Skip (ray, leaf) pairs whose segment crosses only empty cells of the leaf's occupancy mask
+    // (shared/neural_occupancy.h; models without masks query every leaf). --neural-occupancy on|off.
+    bool occupancy = true;
 };
 
 // Leaves per round of `options` (throws nbvh::Error when out of range).

@@ -19,6 +19,9 @@ layout(set = 0, binding = NB_BIND_NEURAL_MLP, scalar) readonly buffer NeuralMlpB
 layout(set = 0, binding = NB_BIND_NBVH_NODES, std430) readonly buffer NbvhNodeBuffer { GpuBvhNode nbvh_nodes[]; };
 // Object-space bounds of every N-BVH node: lo at 2i, hi at 2i + 1.
 layout(set = 0, binding = NB_BIND_NBVH_BOUNDS, scalar) readonly buffer NbvhBoundsBuffer { vec3 nbvh_bounds[]; };
+// The same buffer as words: node i's occupancy mask (shared/neural_occupancy.h) is NB_OCC_WORDS words
+// from neural_params.occupancy + NB_OCC_WORDS * i.
+layout(set = 0, binding = NB_BIND_NBVH_BOUNDS, std430) readonly buffer NbvhBoundsWords { uint nbvh_bounds_words[]; };
 layout(set = 0, binding = NB_BIND_NEURAL_STATE, scalar) buffer NeuralStateBuffer { GpuNeuralRayState neural_state[]; };
 layout(set = 0, binding = NB_BIND_NEURAL_PARAMS, scalar) readonly buffer NeuralParamsBuffer { GpuNeuralParams neural_params; };
 layout(set = 0, binding = NB_BIND_NEURAL_ASSETS, scalar) readonly buffer NeuralAssetBuffer { GpuNeuralAsset neural_assets[]; };

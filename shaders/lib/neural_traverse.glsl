@@ -13,6 +13,7 @@
 #ifndef NB_NEURAL_TRAVERSE_GLSL
 #define NB_NEURAL_TRAVERSE_GLSL
 #include "lib/neural_bindings.glsl"
+#include "shared/neural_occupancy.h"
 
 bool g_nl_skip_triangles = false; // resumed rounds: the triangle hit of round 0 is already known
 uint g_nl_lod = 0u;               // N-BVH cut (LoD) of this ray
@@ -40,12 +41,26 @@ bool nb_nl_key_less(float ta, uint ia, uint la, float tb, uint ib, uint lb) {
 // Key of the worst kept candidate while the list is full (else +inf): the bound a new one must beat.
 float nb_nl_bound_t() { return g_nl_cand_n < g_nl_want ? NB_INF : g_nl_cand_t[g_nl_want - 1u]; }
 
+// Whether the segment [t0, t1] of the ray (object space) crosses an occupied cell of `node`'s mask
+// (shared/neural_occupancy.h); true where the walk is not exact. Without masks: always true.
+bool nb_nl_occupied(uint node, vec3 lo, vec3 hi, float t0, float t1) {
+    if (neural_params.occupancy == 0u) return true;
+    GpuOccWalk w = nb_occ_walk_begin(g_obj_org, g_obj_dir, lo, hi, t0, t1);
+    if (!w.exact) return true;
+    uint base = neural_params.occupancy + node * NB_OCC_WORDS;
+    do {
+        uint bit = nb_occ_walk_bit(w);
+        if ((nbvh_bounds_words[base + (bit >> 5u)] & (1u << (bit & 31u))) != 0u) return true;
+    } while (nb_occ_walk_next(w));
+    return false;
+}
+
 void nb_neural_leaf(uint first, uint count) {
     for (uint k = 0u; k < count; ++k) {
         uint node = first + k;
         float te, tx;
-        if (!nb_neural_leaf_interval(g_obj_org, g_nl_inv_dir, nbvh_bounds[2u * node], nbvh_bounds[2u * node + 1u], te, tx))
-            continue;
+        vec3 lo = nbvh_bounds[2u * node], hi = nbvh_bounds[2u * node + 1u];
+        if (!nb_neural_leaf_interval(g_obj_org, g_nl_inv_dir, lo, hi, te, tx)) continue;
         if (!(tx > g_tmin)) continue; // the leaf lies behind the ray's start
         float key = max(te, g_tmin);
         if (!(key < g_nl_walk_tmax)) continue;
@@ -53,9 +68,11 @@ void nb_neural_leaf(uint first, uint count) {
         if (g_nl_cand_n == g_nl_want) {
             uint w = g_nl_want - 1u;
             if (!nb_nl_key_less(key, g_nl_inst, node, g_nl_cand_t[w], g_nl_cand_inst[w], g_nl_cand_leaf[w])) continue;
-        } else {
-            g_nl_cand_n += 1u;
         }
+        // Only empty cells between the key and the exit: no true hit in this leaf (the part before the
+        // key, behind tmin, holds no accepted hit either). Skipped, not queued.
+        if (!nb_nl_occupied(node, lo, hi, key, tx)) continue;
+        if (g_nl_cand_n < g_nl_want) g_nl_cand_n += 1u;
         // Insertion into the sorted list (the last entry drops out when it was full).
         uint j = g_nl_cand_n - 1u;
         while (j > 0u && nb_nl_key_less(key, g_nl_inst, node, g_nl_cand_t[j - 1u], g_nl_cand_inst[j - 1u],

@@ -148,7 +148,9 @@ struct GpuNeuralParams {
     float threshold;      // visibility threshold
     uint max_rounds;      // leaves queried per ray at most (then the best hit so far is kept)
     uint leaves_per_round; // 1..NB_NL_MAX_LEAVES_PER_ROUND leaves queued per ray per traversal round
-    uint pad1;
+    // Occupancy masks (shared/neural_occupancy.h): their first word in the node-bounds buffer
+    // (NB_BIND_NBVH_BOUNDS seen as words, after the 6 words per node of the bounds), 0 = none or off.
+    uint occupancy;
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 64, "GpuNeuralParams layout");
 

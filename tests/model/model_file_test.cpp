@@ -107,7 +107,7 @@ TEST(ModelFile, SaveIsAtomicAndLoadReadsItBack) {
 // Pins the format: any change to the byte layout must bump MODEL_FORMAT_VERSION and this test.
 TEST(ModelFile, GoldenBytes) {
     const std::vector<uint8_t> b = serialize_model(make_tiny_model());
-    const uint8_t head[16] = {'N', 'B', 'V', 'H', 2, 0, 0, 0, 8, 0, 0, 0, 0, 0, 0, 0};
+    const uint8_t head[16] = {'N', 'B', 'V', 'H', 3, 0, 0, 0, 8, 0, 0, 0, 0, 0, 0, 0};
     ASSERT_GE(b.size(), 16u);
     EXPECT_EQ(std::memcmp(b.data(), head, 16), 0);
     std::vector<std::string> ids;
@@ -122,7 +122,7 @@ TEST(ModelFile, GoldenBytes) {
     const uint32_t node_head[2 + 10] = {5, 0, 0, 0, 0, 0x3f800000u, 0x3f800000u, 0x3f800000u, 1, 0, 0xFFu, 0};
     EXPECT_EQ(std::memcmp(b.data() + section_offset(b, "NODE"), node_head, sizeof(node_head)), 0);
     EXPECT_EQ(b.size(), 40984u);
-    EXPECT_EQ(fnv1a64(b.data(), b.size()), 0x7c713906138de22bull) << std::hex << fnv1a64(b.data(), b.size());
+    EXPECT_EQ(fnv1a64(b.data(), b.size()), 0xe6c026ba917b4388ull) << std::hex << fnv1a64(b.data(), b.size());
 }
 
 TEST(ModelFile, TruncationAnywhereIsRejected) {
@@ -171,9 +171,9 @@ TEST(ModelFile, ForeignFilesAreRejected) {
     expect_rejected(c, "not an nbvh model (bad magic)");
     expect_rejected({}, "not an nbvh model (file too short)");
     c = b;
-    poke<uint32_t>(c, 4, 3);
+    poke<uint32_t>(c, 4, 4);
     refresh_checksums(c);
-    expect_rejected(c, "unsupported model format version 3");
+    expect_rejected(c, "unsupported model format version 4");
     // An official N-BVH tree file (u64 N, u64 1, N x 40 bytes, u64 0) of 3 nodes.
     std::vector<uint8_t> official(16 + 3 * 40 + 8, 0);
     poke<uint64_t>(official, 0, 3);
