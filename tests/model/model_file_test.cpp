@@ -5,6 +5,7 @@
 #include <random>
 
 #include "engine/core/error.h"
+#include "shaders/shared/neural_occupancy.h"
 #include "tests/model/tiny_model.h"
 #include "tests/support/test_support.h"
 
@@ -123,6 +124,41 @@ TEST(ModelFile, GoldenBytes) {
     EXPECT_EQ(std::memcmp(b.data() + section_offset(b, "NODE"), node_head, sizeof(node_head)), 0);
     EXPECT_EQ(b.size(), 40984u);
     EXPECT_EQ(fnv1a64(b.data(), b.size()), 0xe6c026ba917b4388ull) << std::hex << fnv1a64(b.data(), b.size());
+}
+
+// Occupancy masks (version 3): an optional section after META, written only when the model has masks,
+// read back exactly; refused in an older version's file, with the wrong node or word count, or cut short.
+TEST(ModelFile, OccupancyMasksAreAnOptionalSection) {
+    NeuralModel a = make_tiny_model();
+    const std::vector<uint8_t> plain = serialize_model(a);
+    for (const auto& s : test::section_locations(plain)) EXPECT_NE(s.id, "OCCU");
+    EXPECT_TRUE(parse_model(plain).occupancy.empty());
+    const uint64_t plain_bytes = model_gpu_bytes(a);
+    a.occupancy.resize(a.nodes.size() * NB_OCC_WORDS);
+    for (size_t i = 0; i < a.occupancy.size(); ++i) a.occupancy[i] = uint32_t(i * 2654435761u);
+    EXPECT_EQ(model_gpu_bytes(a) - plain_bytes, a.nodes.size() * NB_OCC_WORDS * 4);
+    const std::vector<uint8_t> b = serialize_model(a);
+    std::vector<std::string> ids;
+    for (const auto& s : test::section_locations(b)) ids.push_back(s.id);
+    EXPECT_EQ(ids, (std::vector<std::string>{"CONF", "ASST", "LEVL", "LODS", "NODE", "MLP ", "GRID", "META", "OCCU"}));
+    const uint32_t head[4] = {5, NB_OCC_WORDS, a.occupancy[0], a.occupancy[1]};
+    EXPECT_EQ(std::memcmp(b.data() + section_offset(b, "OCCU"), head, sizeof(head)), 0);
+    EXPECT_EQ(parse_model(b).occupancy, a.occupancy);
+    auto edited = [&](size_t at, uint32_t value) {
+        std::vector<uint8_t> c = b;
+        poke(c, at, value);
+        refresh_checksums(c);
+        return c;
+    };
+    expect_rejected(edited(4, 2), "occupancy masks need format version 3");
+    expect_rejected(edited(section_offset(b, "OCCU"), 4), "4 nodes x 16 words, the model has 5 nodes");
+    expect_rejected(edited(section_offset(b, "OCCU") + 4, 64), "5 nodes x 64 words, the model has 5 nodes x 16");
+    // A shorter payload (the section table says 8 bytes less).
+    std::vector<uint8_t> c = b;
+    for (size_t k = 0; k < ids.size(); ++k)
+        if (ids[k] == "OCCU") poke<uint64_t>(c, 32 + 32 * k + 16, 8 + 5 * NB_OCC_WORDS * 4 - 8);
+    refresh_checksums(c);
+    EXPECT_THROW(parse_model(c, "m.nbvh"), Error);
 }
 
 TEST(ModelFile, TruncationAnywhereIsRejected) {

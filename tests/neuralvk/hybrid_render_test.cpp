@@ -18,6 +18,7 @@
 #include "engine/scene/camera.h"
 #include "engine/scene/environment.h"
 #include "engine/scene/gltf_loader.h"
+#include "shaders/shared/neural_occupancy.h"
 #include "tests/neuralvk/trained_bunny.h"
 #include "tests/support/test_support.h"
 
@@ -45,7 +46,8 @@ Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPat
                       uint32_t lod = 0, int32_t secondary_lod = -1, uint32_t batched_rounds = 256,
                       uint32_t leaves_per_round = NeuralRenderOptions{}.leaves_per_round,
                       uint32_t max_leaves = NeuralRenderOptions{}.max_rounds,
-                      bool sort_rays = RenderOptions{}.sort_rays) {
+                      bool sort_rays = RenderOptions{}.sort_rays, bool occupancy = true,
+                      const NeuralModel* model = nullptr) {
     vk::ContextOptions co;
     co.device = vk::DeviceChoice::cpu;
     co.validation = true;
@@ -68,7 +70,8 @@ Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPat
     o.neural.leaves_per_round = leaves_per_round;
     o.neural.max_rounds = max_leaves;
     o.sort_rays = sort_rays;
-    if (hybrid) o.neural.model = &f.model;
+    o.neural.occupancy = occupancy;
+    if (hybrid) o.neural.model = model ? model : &f.model;
     else o.neural.classical = true;
     WavefrontRenderer r(ctx, f.scene, accel, default_sky(), cam, o);
     RenderResult res = r.render();
@@ -240,3 +243,43 @@ TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
     for (Instance& i : plain.instances) i.neural = false;
     EXPECT_THROW(validate(o, plain), Error);
 }
+
+// Occupancy masks (shaders/shared/neural_occupancy.h): the trained model carries them, the traversal
+// skips leaves whose segment crosses only empty cells: fewer queries, the same image up to the network's
+// answers on those segments (which can only be misses or false hits). Controls: a model whose masks
+// are all set queries exactly as with the masks off (same image), all-clear masks query nothing.
+TEST(HybridRender, OccupancyMasksSkipEmptyLeaves) {
+    NBVH_REQUIRE_SHARED();
+    const Fixture& f = trained_bunny();
+    ASSERT_EQ(f.model.occupancy.size(), f.model.nodes.size() * NB_OCC_WORDS);
+    const NeuralRenderOptions d;
+    auto render = [&](bool occupancy, const NeuralModel* m) {
+        return render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, d.batched_rounds, d.leaves_per_round,
+                            d.max_rounds, RenderOptions{}.sort_rays, occupancy, m);
+    };
+    const Rendered classical = render_bunny(f, false);
+    const Rendered off = render(false, nullptr);
+    const Rendered on = render(true, nullptr);
+    NeuralModel full = f.model, empty = f.model;
+    std::fill(full.occupancy.begin(), full.occupancy.end(), ~0u);
+    std::fill(empty.occupancy.begin(), empty.occupancy.end(), 0u);
+    const Rendered all_set = render(true, &full);
+    const Rendered none_set = render(true, &empty);
+    for (const Rendered* r : {&off, &on, &all_set, &none_set}) {
+        EXPECT_EQ(r->validation, 0);
+        EXPECT_EQ(r->stats.nonfinite_pixels, 0u);
+    }
+    const float flip_on = flip_hdr(classical.image, on.image).mean, flip_off = flip_hdr(classical.image, off.image).mean;
+    std::printf("queries: masks off %llu, on %llu, all set %llu, all clear %llu; HDR-FLIP vs classical: on %.4f, "
+                "off %.4f\n",
+                (unsigned long long)off.stats.neural_queries, (unsigned long long)on.stats.neural_queries,
+                (unsigned long long)all_set.stats.neural_queries, (unsigned long long)none_set.stats.neural_queries,
+                flip_on, flip_off);
+    EXPECT_LT(on.stats.neural_queries, off.stats.neural_queries);
+    EXPECT_GT(on.stats.neural_queries, off.stats.neural_queries / 4);
+    EXPECT_LT(flip_on, flip_off + 0.005f);
+    EXPECT_EQ(all_set.stats.neural_queries, off.stats.neural_queries);
+    EXPECT_EQ(all_set.image.data, off.image.data);
+    EXPECT_EQ(none_set.stats.neural_queries, 0u);
+}
+
