@@ -94,6 +94,7 @@ void StudyRun::run_config(size_t index, const Config& c) {
                               {"levels", bytes.levels},
                               {"nodes", bytes.nodes},
                               {"node_bounds", bytes.node_bounds},
+                              {"occupancy", bytes.occupancy},
                               {"assets", bytes.assets},
                               {"params", bytes.params}}}});
 

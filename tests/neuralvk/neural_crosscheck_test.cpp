@@ -13,6 +13,7 @@
 #include "engine/render/gpu_memory.h"
 #include "engine/render/neural_model_gpu.h"
 #include "engine/vk/context.h"
+#include "shaders/shared/neural_occupancy.h"
 #include "tests/neuralvk/neural_test_model.h"
 
 #include <gtest/gtest.h>
@@ -107,5 +108,16 @@ TEST(NeuralMemory, HostFigureMatchesTheUploadedBuffers) {
     const NeuralModelGpu gpu(ctx, tm.model);
     const NeuralGpuBytes b = neural_gpu_bytes(tm.model);
     EXPECT_EQ(gpu.bytes(), b.total() - b.assets - b.params);
+    EXPECT_EQ(b.occupancy, 0u);
+    // With occupancy masks (after the bounds in the same buffer): counted on both sides.
+    NeuralModel with_masks = tm.model;
+    with_masks.occupancy.assign(with_masks.nodes.size() * NB_OCC_WORDS, ~0u);
+    const NeuralModelGpu gpu_masks(ctx, with_masks);
+    const NeuralGpuBytes bm = neural_gpu_bytes(with_masks);
+    EXPECT_EQ(bm.occupancy, with_masks.nodes.size() * NB_OCC_WORDS * 4);
+    EXPECT_EQ(gpu_masks.bytes(), bm.total() - bm.assets - bm.params);
+    EXPECT_EQ(gpu_masks.bytes() - gpu.bytes(), bm.occupancy);
+    EXPECT_GT(gpu_masks.occupancy_offset(), 0u);
+    EXPECT_EQ(gpu.occupancy_offset(), 0u);
     EXPECT_EQ(ctx.validation_message_count(), 0);
 }
