@@ -71,31 +71,68 @@ __global__ void k_encode(DevNetwork net, DevBatch b) {
 // which serialise in L2 as global atomics. Each block accumulates its share of the samples in shared
 // memory and flushes one global add per touched value.
 constexpr uint32_t kCoarseSmemBytes = 96 * 1024;
+// The grid-backward work of one (sample, level): each of the segment's points adds w_c * dL/dfeatures to
+// the 8 corners of its cell. Points in the same cell (a ray segment's 3 points usually share the coarse
+// levels' cells) are summed in registers first, so `add(entry, value)` runs once per distinct (cell,
+// corner): fewer atomics, the same sum up to float reassociation. Non-finite gradients raise the guard.
+// Used by the coarse levels only: on the fine levels (k_grid_backward, one thread per point) the points
+// rarely share a cell and the merged form measured 1 % slower (H200, results/cuda_training.md).
+template <class Add>
+__device__ void grid_backward_sample_level(const GpuHashLevel& lv, const DevBatch& b, uint32_t i, uint32_t l,
+                                           uint32_t* flag, Add add) {
+    uvec3 cell[NB_SEGMENT_POINTS];
+    vec3 frac[NB_SEGMENT_POINTS];
+    float4 df[NB_SEGMENT_POINTS];
+    bool live[NB_SEGMENT_POINTS];
+    for (uint32_t k = 0; k < NB_SEGMENT_POINTS; ++k) {
+        df[k] = *reinterpret_cast<const float4*>(b.dfeatures + size_t(i) * NB_MLP_INPUTS + nb_feature_slot(k, l, 0));
+        const bool finite = isfinite(df[k].x + df[k].y + df[k].z + df[k].w);
+        if (!finite) atomicOr(flag, NB_GUARD_GRADIENT);
+        live[k] = finite && (df[k].x != 0.0f || df[k].y != 0.0f || df[k].z != 0.0f || df[k].w != 0.0f);
+        const float* pp = b.points + 9 * size_t(i) + 3 * k;
+        nb_grid_position(lv, vec3(pp[0], pp[1], pp[2]), cell[k], frac[k]);
+    }
+    auto same = [&](uint32_t j, uint32_t k) {
+        return cell[j].x == cell[k].x && cell[j].y == cell[k].y && cell[j].z == cell[k].z;
+    };
+    for (uint32_t k = 0; k < NB_SEGMENT_POINTS; ++k) {
+        if (!live[k]) continue;
+        bool merged = false; // into an earlier point of the same cell
+        for (uint32_t j = 0; j < k; ++j) merged |= live[j] && same(j, k);
+        if (merged) continue;
+        for (uint32_t c = 0; c < NB_GRID_CORNERS; ++c) {
+            float4 v = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
+            for (uint32_t j = k; j < NB_SEGMENT_POINTS; ++j) {
+                if (!live[j] || !same(j, k)) continue;
+                const float w = nb_grid_corner_weight(frac[j], c);
+                v.x += w * df[j].x;
+                v.y += w * df[j].y;
+                v.z += w * df[j].z;
+                v.w += w * df[j].w;
+            }
+            add(nb_grid_corner_entry(lv, cell[k], c), v);
+        }
+    }
+}
+
 __global__ void k_grid_backward_coarse(DevNetwork net, DevBatch b, uint32_t coarse_levels, uint32_t coarse_values,
                                        uint32_t* flag) {
     extern __shared__ float acc_s[];
     for (uint32_t v = threadIdx.x; v < coarse_values; v += blockDim.x) acc_s[v] = 0.0f;
     __syncthreads();
-    const uint32_t items = b.n * NB_SEGMENT_POINTS * coarse_levels;
+    // One thread per (sample, coarse level); the shared-memory atomics bound this kernel
+    // (results/cuda_training.md), and merging the points of one cell cuts them by up to 3x.
+    const uint32_t items = b.n * coarse_levels;
     for (uint32_t t = blockIdx.x * blockDim.x + threadIdx.x; t < items; t += gridDim.x * blockDim.x) {
-        const uint32_t i = t / (NB_SEGMENT_POINTS * coarse_levels), r = t % (NB_SEGMENT_POINTS * coarse_levels);
-        const uint32_t k = r / coarse_levels, l = r % coarse_levels;
+        const uint32_t i = t / coarse_levels, l = t % coarse_levels;
         if (b.leaf[i] < 0) continue;
-        const float4 df = *reinterpret_cast<const float4*>(b.dfeatures + size_t(i) * NB_MLP_INPUTS + nb_feature_slot(k, l, 0));
-        if (!isfinite(df.x + df.y + df.z + df.w)) { atomicOr(flag, NB_GUARD_GRADIENT); continue; }
-        const float* pp = b.points + 9 * size_t(i) + 3 * k;
-        const GpuHashLevel lv = net.levels[l];
-        uvec3 cell;
-        vec3 frac;
-        nb_grid_position(lv, vec3(pp[0], pp[1], pp[2]), cell, frac);
-        for (uint32_t c = 0; c < NB_GRID_CORNERS; ++c) {
-            const float w = nb_grid_corner_weight(frac, c);
-            float* dst = acc_s + size_t(nb_grid_corner_entry(lv, cell, c)) * 4; // coarse levels start at entry 0
-            atomicAdd(dst + 0, w * df.x);
-            atomicAdd(dst + 1, w * df.y);
-            atomicAdd(dst + 2, w * df.z);
-            atomicAdd(dst + 3, w * df.w);
-        }
+        grid_backward_sample_level(net.levels[l], b, i, l, flag, [&](uint32_t e, float4 v) {
+            float* dst = acc_s + size_t(e) * 4; // coarse levels start at entry 0
+            atomicAdd(dst + 0, v.x);
+            atomicAdd(dst + 1, v.y);
+            atomicAdd(dst + 2, v.z);
+            atomicAdd(dst + 3, v.w);
+        });
     }
     __syncthreads();
     // One float4 add per touched entry (coarse levels start at entry 0; coarse_values is a multiple of 4).
