@@ -11,7 +11,7 @@
 namespace nbvh {
 
 NeuralModel make_neural_model(const TrainingAsset& asset, const TrainResult& result, const TrainOptions& options,
-                              const std::string& source, uint64_t source_hash) {
+                              const std::string& source, uint64_t source_hash, bool occupancy_masks) {
     NBVH_CHECK(result.tree.frozen());
     NeuralModel m;
     m.cfg = result.weights.cfg;
@@ -32,7 +32,7 @@ NeuralModel make_neural_model(const TrainingAsset& asset, const TrainResult& res
     }
     m.mlp = neural::mlp_to_fp16(result.weights);
     m.grid = neural::grid_to_fp16(result.weights);
-    if (asset.mesh) { // node boxes and mesh: atlas space
+    if (occupancy_masks && asset.mesh) { // node boxes and mesh: atlas space
         const auto t0 = std::chrono::steady_clock::now();
         m.occupancy = build_occupancy(m.nodes, *asset.mesh);
         log_info("occupancy masks: %.0f ms, %.1f %% of the LoD-0 leaves' cells occupied (%zu KiB)",

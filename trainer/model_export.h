@@ -10,8 +10,10 @@
 namespace nbvh {
 
 // `source` is the scene as given on the command line ("default" for the built-in one); `source_hash`
-// the hash of its file (0 when not a file).
+// the hash of its file (0 when not a file). `occupancy_masks`: build the nodes' occupancy masks from the
+// asset's triangles (engine/neural/occupancy.h; off for the viewer's live previews, which are rebuilt
+// every few hundred steps; without masks they render the same surfaces, only slower).
 NeuralModel make_neural_model(const TrainingAsset& asset, const TrainResult& result, const TrainOptions& options,
-                              const std::string& source, uint64_t source_hash);
+                              const std::string& source, uint64_t source_hash, bool occupancy_masks = true);
 
 } // namespace nbvh

@@ -64,7 +64,7 @@ private:
         r.backend = inner_.name();
         TrainOptions one_lod = options_;
         one_lod.lods = 1;
-        auto m = std::make_shared<NeuralModel>(make_neural_model(asset_, r, one_lod, source_, 0));
+        auto m = std::make_shared<NeuralModel>(make_neural_model(asset_, r, one_lod, source_, 0, false));
         m->meta.steps = steps_done;
         return m;
     }
