@@ -38,7 +38,7 @@ void print_model(const std::string& path) {
     const NeuralModel m = load_model(path);
     const NbvhTree tree = m.tree();
     const NeuralConfig& c = m.cfg;
-    std::printf("model        %s (format version %u)\n", path.c_str(), MODEL_FORMAT_VERSION);
+    std::printf("model        %s (format version %u)\n", path.c_str(), m.file_version);
     std::printf("assets       %zu (each its own N-BVH subtree, one shared network)\n", m.assets.size());
     for (const ModelAsset& as : m.assets)
         std::printf("  %-28s %8u triangles  %zu node%s  root %u  scale %g%s\n", as.name.c_str(), as.triangles,

@@ -69,6 +69,7 @@ struct NeuralModel {
     // version 3, or models built without the triangles): every leaf is then queried.
     std::vector<uint32_t> occupancy;
     TrainingMetadata meta;
+    uint32_t file_version = 0;           // format version of the file it was read from (0: not read)
 
     // The tree (parent/depth derived). The nodes must be valid (they are after load_model).
     NbvhTree tree() const { return NbvhTree::from_nodes(nodes, lod_count); }

@@ -452,6 +452,7 @@ NeuralModel decode_sections(const std::vector<SectionView>& sections, const std:
         expect_end(r);
     }
     validate_assets(m, name);
+    m.file_version = version;
     return m;
 }
 

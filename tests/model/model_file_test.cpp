@@ -329,6 +329,8 @@ TEST(ModelFile, Version1FilesStillLoad) {
     poke<uint64_t>(v1, 16, v1.size());
     refresh_checksums(v1);
     const NeuralModel m = parse_model(v1, "old.nbvh");
+    EXPECT_EQ(m.file_version, 1u);
+    EXPECT_EQ(parse_model(v2).file_version, MODEL_FORMAT_VERSION);
     ASSERT_EQ(m.assets.size(), 1u);
     EXPECT_EQ(m.assets[0].name, "old_asset");
     EXPECT_EQ(m.assets[0].material, "");
