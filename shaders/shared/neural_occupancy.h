@@ -85,15 +85,24 @@ NB_FN GpuOccWalk nb_occ_walk_begin(vec3 org, vec3 dir, vec3 lo, vec3 hi, float t
 
 NB_FN uint nb_occ_walk_bit(GpuOccWalk w) { return nb_occ_bit(uint(w.cell.x), uint(w.cell.y), uint(w.cell.z)); }
 
-// Moves to the next cell of the segment; false when the segment (or the grid) ends.
+// Moves to the next cell of the segment; false when the segment ends. A step across the grid's edge
+// (the segment grazes a face: it lies in the leaf box dilated by NB_LEAF_DILATION, and its start may
+// round onto the face) keeps the boundary cell on that axis and stops stepping it, so the walk goes on
+// along the other axes instead of ending with cells of the segment unvisited.
 NB_FN bool nb_occ_walk_next(NB_INOUT(GpuOccWalk) w) {
-    int a = w.t_next.x <= w.t_next.y ? (w.t_next.x <= w.t_next.z ? 0 : 2) : (w.t_next.y <= w.t_next.z ? 1 : 2);
-    if (!(w.t_next[a] <= w.t_end) || w.steps >= NB_OCC_MAX_STEPS) return false;
-    w.cell[a] += w.step[a];
-    if (w.cell[a] < 0 || w.cell[a] >= int(NB_OCC_RES)) return false;
-    w.t_next[a] += w.t_delta[a];
-    w.steps += 1u;
-    return true;
+    for (int guard = 0; guard < 3; ++guard) {
+        int a = w.t_next.x <= w.t_next.y ? (w.t_next.x <= w.t_next.z ? 0 : 2) : (w.t_next.y <= w.t_next.z ? 1 : 2);
+        if (!(w.t_next[a] <= w.t_end) || w.steps >= NB_OCC_MAX_STEPS) return false;
+        int c = w.cell[a] + w.step[a];
+        if (c >= 0 && c < int(NB_OCC_RES)) {
+            w.cell[a] = c;
+            w.t_next[a] += w.t_delta[a];
+            w.steps += 1u;
+            return true;
+        }
+        w.t_next[a] = NB_INF; // out of the grid on this axis: stay in the boundary cell
+    }
+    return false;
 }
 
 #endif // NB_NEURAL_OCCUPANCY_H
