@@ -40,6 +40,9 @@ NB_FN int nb_occ_cell(float g) {
     return min(int(min(g, float(NB_OCC_RES) - 0.5f)), int(NB_OCC_RES) - 1);
 }
 
+// Whether a cell index is the grid's last one in the direction of `step` (no step can follow).
+NB_FN bool nb_occ_at_edge(int cell, int step) { return step > 0 ? cell >= int(NB_OCC_RES) - 1 : cell <= 0; }
+
 struct GpuOccWalk {
     ivec3 cell;
     ivec3 step;
@@ -79,30 +82,26 @@ NB_FN GpuOccWalk nb_occ_walk_begin(vec3 org, vec3 dir, vec3 lo, vec3 hi, float t
             w.t_next[a] = NB_INF;
             w.t_delta[a] = NB_INF;
         }
+        if (w.step[a] != 0 && nb_occ_at_edge(w.cell[a], w.step[a])) w.t_next[a] = NB_INF;
     }
     return w;
 }
 
 NB_FN uint nb_occ_walk_bit(GpuOccWalk w) { return nb_occ_bit(uint(w.cell.x), uint(w.cell.y), uint(w.cell.z)); }
 
-// Moves to the next cell of the segment; false when the segment ends. A step across the grid's edge
-// (the segment grazes a face: it lies in the leaf box dilated by NB_LEAF_DILATION, and its start may
-// round onto the face) keeps the boundary cell on that axis and stops stepping it, so the walk goes on
-// along the other axes instead of ending with cells of the segment unvisited.
+// Moves to the next cell of the segment; false when the segment ends. An axis whose cell is the grid's
+// last one in its step direction takes no further step (t_next = inf, set here and by the begin): a
+// segment grazing a face (it lies in the leaf box dilated by NB_LEAF_DILATION, and its start may round
+// onto the face) keeps that boundary cell and the walk goes on along the other axes, instead of ending
+// with cells of the segment unvisited.
 NB_FN bool nb_occ_walk_next(NB_INOUT(GpuOccWalk) w) {
-    for (int guard = 0; guard < 3; ++guard) {
-        int a = w.t_next.x <= w.t_next.y ? (w.t_next.x <= w.t_next.z ? 0 : 2) : (w.t_next.y <= w.t_next.z ? 1 : 2);
-        if (!(w.t_next[a] <= w.t_end) || w.steps >= NB_OCC_MAX_STEPS) return false;
-        int c = w.cell[a] + w.step[a];
-        if (c >= 0 && c < int(NB_OCC_RES)) {
-            w.cell[a] = c;
-            w.t_next[a] += w.t_delta[a];
-            w.steps += 1u;
-            return true;
-        }
-        w.t_next[a] = NB_INF; // out of the grid on this axis: stay in the boundary cell
-    }
-    return false;
+    int a = w.t_next.x <= w.t_next.y ? (w.t_next.x <= w.t_next.z ? 0 : 2) : (w.t_next.y <= w.t_next.z ? 1 : 2);
+    // t_next >= NB_INF: every axis is done (also when t_end is infinite, in walks that are not exact).
+    if (!(w.t_next[a] <= w.t_end) || w.t_next[a] >= NB_INF || w.steps >= NB_OCC_MAX_STEPS) return false;
+    w.cell[a] += w.step[a];
+    w.t_next[a] = nb_occ_at_edge(w.cell[a], w.step[a]) ? NB_INF : w.t_next[a] + w.t_delta[a];
+    w.steps += 1u;
+    return true;
 }
 
 #endif // NB_NEURAL_OCCUPANCY_H
