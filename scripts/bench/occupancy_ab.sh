@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Occupancy masks A/B (results/perf/ab_occupancy_h200.json): flag_sweep.sh with the masks off and on
+# Occupancy masks A/B (results/perf/ab_occupancy_h100.json): flag_sweep.sh with the masks off and on
 # (frame times, 1080p 16 spp, models trained in the same call), then per scene a 960x540 2048-spp
 # classical reference (seed 7), a classical render and the hybrid with masks on and off (seed 0), and
 # their FLIPs (OUT/flip2048.txt). Usage (GPU machine): scripts/bench/occupancy_ab.sh OUT
