@@ -37,7 +37,7 @@ NeuralModel make_neural_model(const TrainingAsset& asset, const TrainResult& res
         m.occupancy = build_occupancy(m.nodes, *asset.mesh);
         log_info("occupancy masks: %.0f ms, %.1f %% of the LoD-0 leaves' cells occupied (%zu KiB)",
                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count(),
-                 100.0 * occupancy_fraction(m.nodes, m.occupancy, 0), m.occupancy.size() * 4 / 1024);
+                 100.0 * occupancy_fraction(m.tree(), m.occupancy, 0), m.occupancy.size() * 4 / 1024);
     }
     TrainingMetadata& meta = m.meta;
     meta.steps = result.log.size();

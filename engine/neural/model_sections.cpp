@@ -6,8 +6,8 @@
 
 #include "engine/core/log.h"
 #include "engine/neural/level_table.h"
-#include "shaders/shared/neural_occupancy.h"
 #include "shaders/shared/mlp.h"
+#include "shaders/shared/neural_occupancy.h"
 
 namespace nbvh::model_io {
 

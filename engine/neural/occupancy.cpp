@@ -66,7 +66,7 @@ struct Builder {
                 for (int y = y0; y <= y1; ++y)
                     for (int x = x0; x <= x1; ++x) {
                         const uint32_t bit = nb_occ_bit(uint32_t(x), uint32_t(y), uint32_t(z));
-                        if (w[bit >> 5] & (1u << (bit & 31u))) continue;
+                        if (nb_occ_is_set(w[bit >> 5], bit)) continue;
                         if (!one) {
                             const dvec3 clo = l + dvec3(x, y, z) * cell - margin;
                             const dvec3 chi = l + dvec3(x + 1, y + 1, z + 1) * cell + margin;
@@ -149,26 +149,17 @@ bool occupancy_segment_occupied(const uint32_t* words, const glm::vec3& org, con
     if (!w.exact) return true;
     do {
         const uint32_t bit = nb_occ_walk_bit(w);
-        if (words[bit >> 5] & (1u << (bit & 31u))) return true;
+        if (nb_occ_is_set(words[bit >> 5], bit)) return true;
     } while (nb_occ_walk_next(w));
     return false;
 }
 
-double occupancy_fraction(std::span<const NbvhNode> nodes, std::span<const uint32_t> words, uint32_t lod) {
-    if (nodes.empty() || words.size() != nodes.size() * NB_OCC_WORDS) return 1.0;
+double occupancy_fraction(const NbvhTree& tree, std::span<const uint32_t> words, uint32_t lod) {
+    if (words.size() != size_t(tree.node_count()) * NB_OCC_WORDS) return 1.0;
     uint64_t set = 0, all = 0;
-    std::vector<uint32_t> stack{0u};
-    while (!stack.empty()) {
-        const uint32_t i = stack.back();
-        stack.pop_back();
-        const NbvhNode& n = nodes[i];
-        if (!n.has_children() || (n.lod != NBVH_LOD_NONE && lod >= n.lod)) {
-            for (uint32_t k = 0; k < NB_OCC_WORDS; ++k) set += uint64_t(std::popcount(words[size_t(i) * NB_OCC_WORDS + k]));
-            all += NB_OCC_WORDS * 32u;
-        } else {
-            stack.push_back(n.left);
-            stack.push_back(n.left + 1);
-        }
+    for (uint32_t i : tree.leaves_at(lod)) {
+        for (uint32_t k = 0; k < NB_OCC_WORDS; ++k) set += uint64_t(std::popcount(words[size_t(i) * NB_OCC_WORDS + k]));
+        all += NB_OCC_WORDS * 32u;
     }
     return all ? double(set) / double(all) : 1.0;
 }

@@ -27,7 +27,7 @@ bool occupancy_segment_occupied(const uint32_t* words, const glm::vec3& org, con
                                 float t0, float t1);
 
 // Set bits / all bits over the nodes that are leaves of LoD `lod` (for logs and `nbvh info`).
-double occupancy_fraction(std::span<const NbvhNode> nodes, std::span<const uint32_t> words, uint32_t lod);
+double occupancy_fraction(const NbvhTree& tree, std::span<const uint32_t> words, uint32_t lod);
 
 // Triangle vs axis-aligned box overlap (separating axes, Akenine-Moller 2001), double precision;
 // touching counts as overlap. Exposed for tests.

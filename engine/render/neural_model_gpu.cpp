@@ -1,13 +1,12 @@
 #include "engine/render/neural_model_gpu.h"
 
 #include <algorithm>
-#include <cstring>
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
-#include "shaders/shared/neural_occupancy.h"
 #include "engine/vk/commands.h"
 #include "shaders/shared/mlp.h"
+#include "shaders/shared/neural_occupancy.h"
 
 namespace nbvh::render {
 
@@ -141,16 +140,14 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
     pack_lod_nodes(model, nodes, roots_);
     asset_count_ = uint32_t(model.assets.size());
     nodes_ = vk::make_buffer(ctx, nodes, "nbvh nodes");
-    std::vector<glm::vec3> bounds;
-    bounds.reserve(model.nodes.size() * 2);
-    for (const NbvhNode& n : model.nodes) {
-        bounds.push_back(n.bounds.lo);
-        bounds.push_back(n.bounds.hi);
-    }
-    // The occupancy masks (shared/neural_occupancy.h) follow the bounds in the same buffer (the set has
-    // no binding to spare: lavapipe allows 32 storage buffers per stage); models without masks have none.
-    std::vector<uint32_t> words(bounds.size() * 3);
-    std::memcpy(words.data(), bounds.data(), words.size() * 4);
+    // vec3 lo, vec3 hi per node as words, then the occupancy masks (shared/neural_occupancy.h) in the
+    // same buffer (the set has no binding to spare: lavapipe allows 32 storage buffers per stage);
+    // models without masks have none.
+    std::vector<uint32_t> words;
+    words.reserve(model.nodes.size() * 6 + model.occupancy.size());
+    for (const NbvhNode& n : model.nodes)
+        for (const glm::vec3& v : {n.bounds.lo, n.bounds.hi})
+            for (int k = 0; k < 3; ++k) words.push_back(floatBitsToUint(v[k]));
     if (model.occupancy.size() == model.nodes.size() * NB_OCC_WORDS) {
         occupancy_offset_ = uint32_t(words.size());
         words.insert(words.end(), model.occupancy.begin(), model.occupancy.end());

@@ -50,7 +50,7 @@ bool nb_nl_occupied(uint node, vec3 lo, vec3 hi, float t0, float t1) {
     uint base = neural_params.occupancy + node * NB_OCC_WORDS;
     do {
         uint bit = nb_occ_walk_bit(w);
-        if ((nbvh_bounds_words[base + (bit >> 5u)] & (1u << (bit & 31u))) != 0u) return true;
+        if (nb_occ_is_set(nbvh_bounds_words[base + (bit >> 5u)], bit)) return true;
     } while (nb_occ_walk_next(w));
     return false;
 }

@@ -27,6 +27,9 @@
 // Bit of cell (x, y, z) in a node's 16 words: word bit >> 5, bit bit & 31.
 NB_FN uint nb_occ_bit(uint x, uint y, uint z) { return x + NB_OCC_RES * (y + NB_OCC_RES * z); }
 
+// Whether a cell's bit is set in the mask word that holds it (word bit >> 5 of the node's mask).
+NB_FN bool nb_occ_is_set(uint word, uint bit) { return ((word >> (bit & 31u)) & 1u) != 0u; }
+
 // Cells per unit length on each axis (0 on a flat axis: every point lies in its cell 0).
 NB_FN vec3 nb_occ_scale(vec3 lo, vec3 hi) {
     vec3 e = hi - lo;

@@ -440,10 +440,11 @@ TEST(Occupancy, GrazingSegmentWhoseStartRoundsOntoTheFace) {
 
 TEST(Occupancy, Fraction) {
     const std::vector<NbvhNode> nodes = two_leaves(1);
+    const NbvhTree tree = NbvhTree::from_nodes(nodes, 3);
     const std::vector<uint32_t> ones(nodes.size() * NB_OCC_WORDS, ~0u);
-    for (uint32_t lod = 0; lod < 3; ++lod) EXPECT_DOUBLE_EQ(occupancy_fraction(nodes, ones, lod), 1.0);
+    for (uint32_t lod = 0; lod < 3; ++lod) EXPECT_DOUBLE_EQ(occupancy_fraction(tree, ones, lod), 1.0);
     const std::vector<uint32_t> w = build_occupancy(nodes, one_triangle(), 0);
-    const double f0 = occupancy_fraction(nodes, w, 0), f1 = occupancy_fraction(nodes, w, 1);
+    const double f0 = occupancy_fraction(tree, w, 0), f1 = occupancy_fraction(tree, w, 1);
     EXPECT_GT(f0, 0.0);
     EXPECT_LT(f0, 0.1);
     EXPECT_DOUBLE_EQ(f0, 1.0 / 1024.0); // one cell of two leaves

@@ -71,15 +71,15 @@ __global__ void k_encode(DevNetwork net, DevBatch b) {
 // which serialise in L2 as global atomics. Each block accumulates its share of the samples in shared
 // memory and flushes one global add per touched value.
 constexpr uint32_t kCoarseSmemBytes = 96 * 1024;
-// The grid-backward work of one (sample, level): each of the segment's points adds w_c * dL/dfeatures to
-// the 8 corners of its cell. Points in the same cell (a ray segment's 3 points usually share the coarse
-// levels' cells) are summed in registers first, so `add(entry, value)` runs once per distinct (cell,
-// corner): fewer atomics, the same sum up to float reassociation. Non-finite gradients raise the guard.
-// Used by the coarse levels only: on the fine levels (k_grid_backward, one thread per point) the points
-// rarely share a cell and the merged form measured 1 % slower (H200, results/cuda_training.md).
-template <class Add>
-__device__ void grid_backward_sample_level(const GpuHashLevel& lv, const DevBatch& b, uint32_t i, uint32_t l,
-                                           uint32_t* flag, Add add) {
+// The coarse-level backward of one (sample, level): each of the segment's points adds w_c * dL/dfeatures
+// to the 8 corners of its cell in the block's shared accumulator. Points in the same cell (a ray
+// segment's 3 points usually share the coarse levels' cells) are summed in registers first, so the 4
+// shared atomics run once per distinct (cell, corner): up to 3x fewer, the same sum up to float
+// reassociation. Non-finite gradients raise the guard. Not used on the fine levels (k_grid_backward,
+// one thread per point): there the points rarely share a cell and the merged form measured 1 % slower
+// (H200, results/cuda_training.md).
+__device__ void coarse_backward_sample_level(const GpuHashLevel& lv, const DevBatch& b, uint32_t i, uint32_t l,
+                                             uint32_t* flag, float* acc_s) {
     uvec3 cell[NB_SEGMENT_POINTS];
     vec3 frac[NB_SEGMENT_POINTS];
     float4 df[NB_SEGMENT_POINTS];
@@ -110,7 +110,11 @@ __device__ void grid_backward_sample_level(const GpuHashLevel& lv, const DevBatc
                 v.z += w * df[j].z;
                 v.w += w * df[j].w;
             }
-            add(nb_grid_corner_entry(lv, cell[k], c), v);
+            float* dst = acc_s + size_t(nb_grid_corner_entry(lv, cell[k], c)) * 4; // coarse levels start at entry 0
+            atomicAdd(dst + 0, v.x);
+            atomicAdd(dst + 1, v.y);
+            atomicAdd(dst + 2, v.z);
+            atomicAdd(dst + 3, v.w);
         }
     }
 }
@@ -126,13 +130,7 @@ __global__ void k_grid_backward_coarse(DevNetwork net, DevBatch b, uint32_t coar
     for (uint32_t t = blockIdx.x * blockDim.x + threadIdx.x; t < items; t += gridDim.x * blockDim.x) {
         const uint32_t i = t / coarse_levels, l = t % coarse_levels;
         if (b.leaf[i] < 0) continue;
-        grid_backward_sample_level(net.levels[l], b, i, l, flag, [&](uint32_t e, float4 v) {
-            float* dst = acc_s + size_t(e) * 4; // coarse levels start at entry 0
-            atomicAdd(dst + 0, v.x);
-            atomicAdd(dst + 1, v.y);
-            atomicAdd(dst + 2, v.z);
-            atomicAdd(dst + 3, v.w);
-        });
+        coarse_backward_sample_level(net.levels[l], b, i, l, flag, acc_s);
     }
     __syncthreads();
     // One float4 add per touched entry (coarse levels start at entry 0; coarse_values is a multiple of 4).
