@@ -109,6 +109,7 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
       rounds_(o.max_rounds), capacity_(ray_capacity) {
     set_params(o);
     assets_ = asset_table(model, model_, scene);
+    for (GpuNeuralAsset& a : assets_) a.inside_cos = o.inside_cos;
 }
 
 std::vector<GpuNeuralAsset> NeuralStage::asset_table(const NeuralModel& model, const NeuralModelGpu& gpu,
@@ -122,6 +123,7 @@ std::vector<GpuNeuralAsset> NeuralStage::asset_table(const NeuralModel& model, c
         g.material = 0;
         g.metallic = 0.0f;
         g.roughness = 1.0f;
+        g.inside_cos = 2.0f;
         for (uint32_t m = 0; m < scene.meshes.size(); ++m)
             if (asset_of_mesh(model, scene, m) == int32_t(a) && !scene.meshes[m].triangle_material.empty()) {
                 g.material = scene.meshes[m].triangle_material[0];

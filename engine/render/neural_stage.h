@@ -60,6 +60,9 @@ struct NeuralRenderOptions {
     // Skip (ray, leaf) pairs whose segment crosses only empty cells of the leaf's occupancy mask
     // (shared/neural_occupancy.h; models without masks query every leaf). --neural-occupancy on|off.
     bool occupancy = true;
+    // End paths at neural hits whose predicted normal faces along the ray by more than this cosine
+    // (> 1: off). --neural-inside-cos.
+    float inside_cos = 2.0f;
 };
 
 // Leaves per round of `options` (throws nbvh::Error when out of range).

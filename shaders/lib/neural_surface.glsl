@@ -32,4 +32,14 @@ Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t) {
     return s;
 }
 
+// True when the path should end at this neural hit: its predicted normal faces along the ray by more
+// than the asset's inside_cos (the ray is inside a solid asset).
+bool nb_neural_inside(uint ray, vec3 ray_dir) {
+    GpuNeuralRayState st = neural_state[ray];
+    float c = neural_assets[instances[st.instance].blas_root].inside_cos;
+    if (!(c <= 1.0f)) return false;
+    vec3 n = st.normal;
+    return dot(n, ray_dir) > c * sqrt(dot(n, n) * dot(ray_dir, ray_dir));
+}
+
 #endif

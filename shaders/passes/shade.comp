@@ -57,6 +57,7 @@ void main() {
         sample_radiance[slot] += throughput * s.emission * w;
     }
     if (depth + 1u >= params.max_depth) return; // the next segment would exceed --max-depth
+    if (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE && nb_neural_inside(i, dir)) return;
 
     // Next-event estimation.
     if (NB_HAS_ENVIRONMENT || NB_HAS_EMISSION || NB_HAS_PUNCTUAL) {

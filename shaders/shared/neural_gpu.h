@@ -134,7 +134,9 @@ struct GpuNeuralAsset {
     uint material;                  // index into the scene materials (emission, transmission)
     float metallic;                 // engine/neural/asset_table.h asset_shading: factor x mean texture
     float roughness;
-    uint pad0;
+    // A hit whose predicted normal n has dot(n, ray direction) > inside_cos ends the path (the ray is
+    // inside a solid asset); > 1: never.
+    float inside_cos;
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralAsset) == 48, "GpuNeuralAsset layout");
 
