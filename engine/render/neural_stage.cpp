@@ -108,12 +108,11 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
     : ctx_(ctx), model_(ctx, model), kernel_(choose_neural_kernel(ctx.features(), o.path)),
       rounds_(o.max_rounds), capacity_(ray_capacity) {
     set_params(o);
-    assets_ = asset_table(model, model_, scene);
-    for (GpuNeuralAsset& a : assets_) a.inside_cos = o.inside_cos;
+    assets_ = asset_table(model, model_, scene, o);
 }
 
 std::vector<GpuNeuralAsset> NeuralStage::asset_table(const NeuralModel& model, const NeuralModelGpu& gpu,
-                                                     const Scene& scene) {
+                                                     const Scene& scene, const NeuralRenderOptions& o) {
     // Each asset's subtree root per LoD (LoDs past the model's repeat its coarsest) and the material of
     // the scene mesh it answers (one material per asset after bind_model_to_scene).
     std::vector<GpuNeuralAsset> assets(model.assets.size());
@@ -123,7 +122,7 @@ std::vector<GpuNeuralAsset> NeuralStage::asset_table(const NeuralModel& model, c
         g.material = 0;
         g.metallic = 0.0f;
         g.roughness = 1.0f;
-        g.inside_cos = 2.0f;
+        g.backface_escape = o.backface_escape ? 1u : 0u;
         for (uint32_t m = 0; m < scene.meshes.size(); ++m)
             if (asset_of_mesh(model, scene, m) == int32_t(a) && !scene.meshes[m].triangle_material.empty()) {
                 g.material = scene.meshes[m].triangle_material[0];
@@ -140,7 +139,7 @@ std::vector<GpuNeuralAsset> NeuralStage::asset_table(const NeuralModel& model, c
 void NeuralStage::set_model(const NeuralModel& model, const Scene& scene, const NeuralRenderOptions& o,
                             std::vector<vk::Buffer>& buffers) {
     NeuralModelGpu next(ctx_, model); // throws before anything changes
-    std::vector<GpuNeuralAsset> assets = asset_table(model, next, scene);
+    std::vector<GpuNeuralAsset> assets = asset_table(model, next, scene, o);
     model_ = std::move(next);
     assets_ = std::move(assets);
     set_params(o);

@@ -60,9 +60,10 @@ struct NeuralRenderOptions {
     // Skip (ray, leaf) pairs whose segment crosses only empty cells of the leaf's occupancy mask
     // (shared/neural_occupancy.h; models without masks query every leaf). --neural-occupancy on|off.
     bool occupancy = true;
-    // End paths at neural hits whose predicted normal faces along the ray by more than this cosine
-    // (> 1: off). --neural-inside-cos.
-    float inside_cos = 2.0f;
+    // A ray leaving a neural hit seen from behind (predicted normal along the incoming ray) skips
+    // back-facing neural hits, so that it leaves the asset instead of bouncing inside it
+    // (NB_RAY_BACKFACE_BIT, engine/render/NEURAL.md). --neural-backface-escape on|off.
+    bool backface_escape = true;
 };
 
 // Leaves per round of `options` (throws nbvh::Error when out of range).
@@ -116,9 +117,10 @@ public:
 
 private:
     void set_params(const NeuralRenderOptions& options);
-    // The asset table: each asset's subtree root per LoD and the material of the scene mesh it answers.
+    // The asset table: each asset's subtree root per LoD, the material of the scene mesh it answers
+    // and the options' back-face escape.
     static std::vector<GpuNeuralAsset> asset_table(const NeuralModel& model, const NeuralModelGpu& gpu,
-                                                   const Scene& scene);
+                                                   const Scene& scene, const NeuralRenderOptions& options);
     void install_model(std::vector<vk::Buffer>& buffers);
 
     const vk::Context& ctx_;

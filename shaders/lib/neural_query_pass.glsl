@@ -50,20 +50,13 @@ float nb_neural_pair_hit(NbPendingQuery r, float y[NB_MLP_OUTPUTS], out vec3 nor
     bool shadow = ray >= cap;
     float tmin = shadow ? 0.0f : uintBitsToFloat(ray_load1(pc.in_queue, NB_RAY_T_RESUME, ray));
     float tmax = shadow ? uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, ray - cap)) : NB_INF;
+    // A ray leaving a hit seen from behind starts inside a part: back faces are its way out.
+    bool escape = ((shadow ? shadow_load1(NB_SHADOW_PIXEL, ray - cap) : ray_load1(pc.in_queue, NB_RAY_DEPTH, ray)) &
+                   NB_RAY_BACKFACE_BIT) != 0u;
     normal = vec3(0.0f, 0.0f, 1.0f);
     albedo = h.albedo;
     if ((h.flags & (NB_NEURAL_VISIBLE | NB_NEURAL_ACCEPTED)) == (NB_NEURAL_VISIBLE | NB_NEURAL_ACCEPTED) &&
-        h.t > tmin && h.t < tmax) {
-        // EXPERIMENT (issue 14): inside_cos 9..11 skips back-facing hits of every query, 19..21 only of
-        // reversed (origin inside the leaf) queries; cosine = value - 10 / - 20.
-        float c = neural_assets[instances[r.pl.instance].blas_root].inside_cos;
-        if (c > 5.0f) {
-            bool only_rev = c > 15.0f;
-            float cc = c - (only_rev ? 20.0f : 10.0f);
-            float nd = dot(h.normal, r.dir);
-            if ((!only_rev || nb_query_reversed(r.pl.t_enter)) && nd > cc * length(h.normal) * length(r.dir))
-                return NB_INF;
-        }
+        h.t > tmin && h.t < tmax && !(escape && dot(h.normal, r.dir) > 0.0f)) {
         vec3 n = nb_xform_normal(instances[r.pl.instance].world_to_object, h.normal);
         float len = length(n);
         normal = len > 0.0f ? n / len : vec3(0.0f, 0.0f, 1.0f);

@@ -32,14 +32,11 @@ Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t) {
     return s;
 }
 
-// True when the path should end at this neural hit: its predicted normal faces along the ray by more
-// than the asset's inside_cos (the ray is inside a solid asset).
-bool nb_neural_inside(uint ray, vec3 ray_dir) {
+// True when the ray leaving neural hit `ray` must skip back-facing neural hits: the hit's asset has
+// backface_escape and its predicted normal faces along the incoming ray (NB_RAY_BACKFACE_BIT).
+bool nb_neural_escapes(uint ray, vec3 ray_dir) {
     GpuNeuralRayState st = neural_state[ray];
-    float c = neural_assets[instances[st.instance].blas_root].inside_cos;
-    if (!(c <= 1.0f)) return false;
-    vec3 n = st.normal;
-    return dot(n, ray_dir) > c * sqrt(dot(n, n) * dot(ray_dir, ray_dir));
+    return neural_assets[instances[st.instance].blas_root].backface_escape != 0u && dot(st.normal, ray_dir) > 0.0f;
 }
 
 #endif

@@ -26,7 +26,7 @@ void main() {
     vec3 dir = ray_load3(q, NB_RAY_DIR, i);
     vec3 throughput = ray_load3(q, NB_RAY_THROUGHPUT, i);
     uint slot = ray_load1(q, NB_RAY_PIXEL, i);
-    uint depth = ray_load1(q, NB_RAY_DEPTH, i);
+    uint depth = ray_load1(q, NB_RAY_DEPTH, i) & ~NB_RAY_BACKFACE_BIT;
     uint rng = ray_load1(q, NB_RAY_RNG, i);
     float prev_pdf = uintBitsToFloat(ray_load1(q, NB_RAY_PDF, i));
     float p_env, p_emissive, p_punctual;
@@ -46,6 +46,8 @@ void main() {
     Surface s = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE) ? nb_make_neural_surface(i, org, dir, t)
                                                                    : nb_make_surface(instance, tri_index, hit_load_bary(i), org, dir, t);
     vec3 wo = -dir;
+    // Rays leaving a neural hit seen from behind skip back-facing neural hits (NB_RAY_BACKFACE_BIT).
+    uint escape = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE && nb_neural_escapes(i, dir)) ? NB_RAY_BACKFACE_BIT : 0u;
 
     if (NB_HAS_EMISSION && dot(s.emission, s.emission) > 0.0f) {
         float w = 1.0f;
@@ -57,7 +59,6 @@ void main() {
         sample_radiance[slot] += throughput * s.emission * w;
     }
     if (depth + 1u >= params.max_depth) return; // the next segment would exceed --max-depth
-    if (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE && nb_neural_inside(i, dir)) return;
 
     // Next-event estimation.
     if (NB_HAS_ENVIRONMENT || NB_HAS_EMISSION || NB_HAS_PUNCTUAL) {
@@ -92,7 +93,7 @@ void main() {
                 float tmax = dist >= NB_INF ? NB_INF : max(0.0f, length(s.p + wi * dist - o) * (1.0f - 1.0e-4f));
                 shadow_store1(NB_SHADOW_TMAX, k, floatBitsToUint(tmax));
                 shadow_store3(NB_SHADOW_CONTRIB, k, contrib);
-                shadow_store1(NB_SHADOW_PIXEL, k, slot);
+                shadow_store1(NB_SHADOW_PIXEL, k, slot | escape);
             }
         }
     }
@@ -119,7 +120,7 @@ void main() {
     ray_store3(out_q, NB_RAY_DIR, k, wi);
     ray_store3(out_q, NB_RAY_THROUGHPUT, k, throughput);
     ray_store1(out_q, NB_RAY_PIXEL, k, slot);
-    ray_store1(out_q, NB_RAY_DEPTH, k, depth + 1u);
+    ray_store1(out_q, NB_RAY_DEPTH, k, (depth + 1u) | escape);
     ray_store1(out_q, NB_RAY_RNG, k, rng);
     ray_store1(out_q, NB_RAY_PDF, k, floatBitsToUint(pdf));
     ray_store1(out_q, NB_RAY_T_RESUME, k, floatBitsToUint(0.0f));

@@ -134,9 +134,9 @@ struct GpuNeuralAsset {
     uint material;                  // index into the scene materials (emission, transmission)
     float metallic;                 // engine/neural/asset_table.h asset_shading: factor x mean texture
     float roughness;
-    // A hit whose predicted normal n has dot(n, ray direction) > inside_cos ends the path (the ray is
-    // inside a solid asset); > 1: never.
-    float inside_cos;
+    // 1: a ray leaving a hit of this asset seen from behind skips back-facing neural hits
+    // (NB_RAY_BACKFACE_BIT, shared/wavefront_gpu.h; --neural-backface-escape); 0: off.
+    uint backface_escape;
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralAsset) == 48, "GpuNeuralAsset layout");
 

@@ -109,7 +109,7 @@
 #define NB_LAYOUT_FIELDS_GpuNeuralCounters(F) F(pending_active) F(queries_total) F(leaf_cap_rays) F(rounds) F(queries_total_hi) F(pad0) F(pad1) F(pad2)
 #define NB_LAYOUT_FIELDS_GpuNeuralAsset(F)                                                        \
     F(roots[0]) F(roots[1]) F(roots[2]) F(roots[3]) F(roots[4]) F(roots[5]) F(roots[6]) F(roots[7]) \
-    F(material) F(metallic) F(roughness) F(inside_cos)
+    F(material) F(metallic) F(roughness) F(backface_escape)
 
 // --- distinct, exactly representable, non-zero values ------------------------------------------
 // Field number k gets base value 16k (+1 for each further component), so every 4-byte word of a
