@@ -53,6 +53,8 @@ float nb_neural_pair_hit(NbPendingQuery r, float y[NB_MLP_OUTPUTS], out vec3 nor
     // A ray leaving a hit seen from behind starts inside a part: back faces are its way out.
     bool escape = ((shadow ? shadow_load1(NB_SHADOW_PIXEL, ray - cap) : ray_load1(pc.in_queue, NB_RAY_DEPTH, ray)) &
                    NB_RAY_BACKFACE_BIT) != 0u;
+    if ((neural_assets[instances[r.pl.instance].blas_root].backface_escape & 4u) != 0u && !nb_query_reversed(r.pl.t_enter))
+        escape = false; // EXPERIMENT: only in the leaf the ray starts in
     normal = vec3(0.0f, 0.0f, 1.0f);
     albedo = h.albedo;
     if ((h.flags & (NB_NEURAL_VISIBLE | NB_NEURAL_ACCEPTED)) == (NB_NEURAL_VISIBLE | NB_NEURAL_ACCEPTED) &&
