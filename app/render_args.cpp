@@ -37,7 +37,6 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
            "a ray leaving a neural hit seen from behind skips back-facing neural hits, so that it leaves the "
            "asset (on, default) or bounces on inside it (off: the paper's and the official code's behaviour)")
         ->check(CLI::IsMember({"on", "off"}));
-    cmd->add_option("--neural-backface-escape-mask", o.neural.backface_escape_mask, "experiment");
     cmd->add_option_function<std::string>(
            "--sort-rays", [&o](const std::string& v) { o.sort_rays = v == "on"; },
            "trace secondary and shadow rays grouped by direction and origin (on, default) "

@@ -64,7 +64,6 @@ struct NeuralRenderOptions {
     // back-facing neural hits, so that it leaves the asset instead of bouncing inside it
     // (NB_RAY_BACKFACE_BIT, engine/render/NEURAL.md). --neural-backface-escape on|off.
     bool backface_escape = true;
-    uint32_t backface_escape_mask = 3; // EXPERIMENT: 1 path rays, 2 shadow rays
 };
 
 // Leaves per round of `options` (throws nbvh::Error when out of range).

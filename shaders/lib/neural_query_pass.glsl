@@ -50,17 +50,12 @@ float nb_neural_pair_hit(NbPendingQuery r, float y[NB_MLP_OUTPUTS], out vec3 nor
     bool shadow = ray >= cap;
     float tmin = shadow ? 0.0f : uintBitsToFloat(ray_load1(pc.in_queue, NB_RAY_T_RESUME, ray));
     float tmax = shadow ? uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, ray - cap)) : NB_INF;
-    // A ray leaving a hit seen from behind starts inside a part: back faces are its way out.
-    bool escape = ((shadow ? shadow_load1(NB_SHADOW_PIXEL, ray - cap) : ray_load1(pc.in_queue, NB_RAY_DEPTH, ray)) &
-                   NB_RAY_BACKFACE_BIT) != 0u;
-    uint emask = neural_assets[instances[r.pl.instance].blas_root].backface_escape;
-    // EXPERIMENT: bit 2 path rays / bit 3 shadow rays skip only in the leaf they start in; bits 8..15 cosine x 100
-    if ((emask & (shadow ? 8u : 4u)) != 0u && !nb_query_reversed(r.pl.t_enter)) escape = false;
-    float emargin = float((emask >> 8u) & 255u) * 0.01f;
+    bool flagged = ((shadow ? shadow_load1(NB_SHADOW_PIXEL, ray - cap) : ray_load1(pc.in_queue, NB_RAY_DEPTH, ray)) &
+                    NB_RAY_BACKFACE_BIT) != 0u;
     normal = vec3(0.0f, 0.0f, 1.0f);
     albedo = h.albedo;
     if ((h.flags & (NB_NEURAL_VISIBLE | NB_NEURAL_ACCEPTED)) == (NB_NEURAL_VISIBLE | NB_NEURAL_ACCEPTED) &&
-        h.t > tmin && h.t < tmax && !(escape && dot(h.normal, r.dir) > emargin * length(h.normal) * length(r.dir))) {
+        h.t > tmin && h.t < tmax && !nb_backface_skip(flagged, shadow, nb_query_reversed(r.pl.t_enter), h.normal, r.dir)) {
         vec3 n = nb_xform_normal(instances[r.pl.instance].world_to_object, h.normal);
         float len = length(n);
         normal = len > 0.0f ? n / len : vec3(0.0f, 0.0f, 1.0f);

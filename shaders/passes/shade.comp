@@ -47,9 +47,7 @@ void main() {
                                                                    : nb_make_surface(instance, tri_index, hit_load_bary(i), org, dir, t);
     vec3 wo = -dir;
     // Rays leaving a neural hit seen from behind skip back-facing neural hits (NB_RAY_BACKFACE_BIT).
-    uint escape_mask = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE) ? nb_neural_escapes(i, dir) : 0u;
-    uint escape = (escape_mask & 1u) != 0u ? NB_RAY_BACKFACE_BIT : 0u;
-    uint escape_shadow = (escape_mask & 2u) != 0u ? NB_RAY_BACKFACE_BIT : 0u;
+    uint escape = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE && nb_neural_escapes(i, dir)) ? NB_RAY_BACKFACE_BIT : 0u;
 
     if (NB_HAS_EMISSION && dot(s.emission, s.emission) > 0.0f) {
         float w = 1.0f;
@@ -95,7 +93,7 @@ void main() {
                 float tmax = dist >= NB_INF ? NB_INF : max(0.0f, length(s.p + wi * dist - o) * (1.0f - 1.0e-4f));
                 shadow_store1(NB_SHADOW_TMAX, k, floatBitsToUint(tmax));
                 shadow_store3(NB_SHADOW_CONTRIB, k, contrib);
-                shadow_store1(NB_SHADOW_PIXEL, k, slot | escape_shadow);
+                shadow_store1(NB_SHADOW_PIXEL, k, slot | escape);
             }
         }
     }

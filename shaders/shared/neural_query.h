@@ -104,6 +104,33 @@ NB_FN bool nb_segment_points(GpuEncodingBox box, vec3 ro, vec3 rd, float t_entry
 
 NB_FN bool nb_decode_visibility(float y0, float threshold) { return y0 > threshold; }
 
+// Back-face escape (a departure from the paper and the official code; engine/render/NEURAL.md). A ray
+// that leaves a neural hit seen from behind (its predicted normal faced along the incoming ray: the
+// first test below, with cosine 0) carries NB_RAY_BACKFACE_BIT (shared/wavefront_gpu.h). Such hits come
+// mostly from the reversed query of the leaf a ray starts in, which answers the LAST surface of the
+// leaf: the far side of a part the ray crosses. Shaded there with the normal turned towards the ray,
+// the path reflects into the part and bounces inside it, and its shadow rays are blocked by the part's
+// own back faces. A flagged ray skips hits whose predicted normal n faces along its direction d by
+// more than NB_BACKFACE_ESCAPE_COS: shadow rays in every leaf, path rays only in the leaf they start in
+// (reversed queries), so that neither leaks through other parts seen from behind (thin strands), which
+// measured worse on the default scene's rope (results/perf/README.md, back-face escape). The
+// cosine keeps hits whose predicted normal is merely grazing (normal error on bumpy surfaces).
+#define NB_BACKFACE_ESCAPE_COS 0.3f
+
+// True when the predicted normal n faces along direction d by more than cosine c (any lengths; false
+// for zero or non-finite vectors).
+NB_FN bool nb_faces_along(vec3 n, vec3 d, float c) {
+    float nd = dot(n, d);
+    float len2 = dot(n, n) * dot(d, d);
+    if (!(len2 > 0.0f) || !(len2 < 3.0e38f)) return false;
+    return nd > 0.0f && nd * nd > c * c * len2;
+}
+
+// True when a flagged ray (NB_RAY_BACKFACE_BIT) skips this query's hit with predicted normal n.
+NB_FN bool nb_backface_skip(bool flagged, bool shadow_ray, bool reversed, vec3 n, vec3 d) {
+    return flagged && (shadow_ray || reversed) && nb_faces_along(n, d, NB_BACKFACE_ESCAPE_COS);
+}
+
 // Depth decode (LocalT). Returns false when the inside-origin margin rejects the hit; t_hit is the ray
 // parameter of the hit along the FORWARD ray either way.
 // dir_len: the length of the ray direction in the encoding (object) space. The box's depth_pad and

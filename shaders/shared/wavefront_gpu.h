@@ -51,13 +51,9 @@ NB_FN uint nb_hit_word(uint field, uint capacity, uint index, uint components) {
 #define NB_SHADOW_PIXEL 10u       // uint the path's slot in its wave, as NB_RAY_PIXEL
 #define NB_SHADOW_WORDS 11u
 
-// Bit 31 of NB_RAY_DEPTH and of NB_SHADOW_PIXEL: the ray leaves a neural hit seen from behind (its
-// predicted normal faced along the incoming ray) of an asset with backface_escape (neural_gpu.h), so
-// its neural queries skip back-facing hits (lib/neural_query_pass.glsl). Such hits come mostly from
-// the paper's reversed query of a leaf the ray starts in: it returns the LAST surface in the leaf,
-// the far side of a part the ray crosses, and a path shaded there with the normal turned towards it
-// reflects into the part and stays trapped inside (engine/render/NEURAL.md). Depths and slots stay
-// far below 2^31.
+// Bit 31 of NB_RAY_DEPTH and of NB_SHADOW_PIXEL: the ray leaves a neural hit seen from behind, of an
+// asset with backface_escape (neural_gpu.h): its neural queries skip back-facing hits (neural_query.h
+// nb_backface_skip). Depths and slots stay far below 2^31; readers mask the bit off.
 #define NB_RAY_BACKFACE_BIT 0x80000000u
 
 NB_FN uint nb_shadow_word(uint field, uint capacity, uint index, uint components) {

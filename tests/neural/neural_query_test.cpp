@@ -183,3 +183,42 @@ TEST(NeuralQuery, DepthDecodeIsTheSameHitAtEveryInstanceScale) {
     EXPECT_TRUE(nb_decode_depth(b, 0.5f, 2.0f, 4.0f, std::nanf(""), t));
     EXPECT_TRUE(std::isfinite(t));
 }
+
+// Back-face escape (neural_query.h nb_backface_skip): which hits a ray leaving a back-facing neural hit
+// skips. Hard cases: grazing normals either side of the cosine, degenerate and non-finite vectors (the
+// hit is kept: the previous behaviour), object-space directions of tiny and huge instance scales.
+TEST(NeuralQuery, BackfaceEscapeSkipsOnlyClearBackFaces) {
+    const vec3 d(0.0f, 0.0f, 1.0f);
+    const float c = NB_BACKFACE_ESCAPE_COS;
+    const float s = std::sqrt(1.0f - c * c);
+    // flagged path ray, reversed query (the leaf it starts in): back faces beyond the cosine are skipped
+    EXPECT_TRUE(nb_backface_skip(true, false, true, vec3(0.0f, 0.0f, 1.0f), d));
+    EXPECT_TRUE(nb_backface_skip(true, false, true, vec3(s * 0.99f, 0.0f, c * 1.01f), d));
+    EXPECT_FALSE(nb_backface_skip(true, false, true, vec3(s * 1.01f, 0.0f, c * 0.99f), d)); // grazing: kept
+    EXPECT_FALSE(nb_backface_skip(true, false, true, vec3(1.0f, 0.0f, 0.0f), d));             // perpendicular
+    EXPECT_FALSE(nb_backface_skip(true, false, true, vec3(0.0f, 0.0f, -1.0f), d));            // front face
+    // path rays keep back faces of later leaves (forward queries); shadow rays skip them in every leaf
+    EXPECT_FALSE(nb_backface_skip(true, false, false, vec3(0.0f, 0.0f, 1.0f), d));
+    EXPECT_TRUE(nb_backface_skip(true, true, false, vec3(0.0f, 0.0f, 1.0f), d));
+    EXPECT_TRUE(nb_backface_skip(true, true, true, vec3(0.0f, 0.0f, 1.0f), d));
+    // unflagged rays skip nothing
+    EXPECT_FALSE(nb_backface_skip(false, true, true, vec3(0.0f, 0.0f, 1.0f), d));
+    // lengths do not matter (decoded normals are unit, object-space directions are 1 / instance scale)
+    for (float scale : {1e-4f, 1e-2f, 1.0f, 1e2f, 1e4f}) {
+        const vec3 ds = d * scale;
+        EXPECT_TRUE(nb_backface_skip(true, true, true, vec3(s * 0.99f, 0.0f, c * 1.01f), ds)) << scale;
+        EXPECT_FALSE(nb_backface_skip(true, true, true, vec3(s * 1.01f, 0.0f, c * 0.99f), ds)) << scale;
+        EXPECT_TRUE(nb_faces_along(vec3(0.0f, 0.0f, 1.0f) * 0.5f, ds, 0.0f)) << scale;
+    }
+    // degenerate and non-finite: never a skip
+    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_FALSE(nb_backface_skip(true, true, true, vec3(0.0f), d));
+    EXPECT_FALSE(nb_backface_skip(true, true, true, vec3(0.0f, 0.0f, 1.0f), vec3(0.0f)));
+    EXPECT_FALSE(nb_backface_skip(true, true, true, vec3(nan, 0.0f, 1.0f), d));
+    EXPECT_FALSE(nb_backface_skip(true, true, true, vec3(0.0f, 0.0f, 1.0f), vec3(0.0f, 0.0f, inf)));
+    EXPECT_FALSE(nb_backface_skip(true, true, true, vec3(0.0f, 0.0f, 1.0f), vec3(0.0f, 0.0f, 1e30f)));
+    // the flag test of the shade pass (cosine 0): any predicted normal along the ray
+    EXPECT_TRUE(nb_faces_along(vec3(1.0f, 0.0f, 1e-3f), d, 0.0f));
+    EXPECT_FALSE(nb_faces_along(vec3(1.0f, 0.0f, 0.0f), d, 0.0f));
+    EXPECT_FALSE(nb_faces_along(vec3(1.0f, 0.0f, -1e-3f), d, 0.0f));
+}
