@@ -43,13 +43,11 @@ struct Rendered {
     int validation = 0;
 };
 
-Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPath::scalar, float threshold = 0.5f,
-                      uint32_t lod = 0, int32_t secondary_lod = -1, uint32_t batched_rounds = 256,
-                      uint32_t leaves_per_round = NeuralRenderOptions{}.leaves_per_round,
-                      uint32_t max_leaves = NeuralRenderOptions{}.max_rounds,
-                      bool sort_rays = RenderOptions{}.sort_rays, bool occupancy = true,
-                      const NeuralModel* model = nullptr,
-                      const std::function<void(RenderOptions&)>& tweak = nullptr) {
+using Tweak = std::function<void(RenderOptions&)>;
+
+// 64x64, 4 spp, 3 segments, the scalar MLP, the renderer's defaults otherwise; `tweak` changes options
+// after these (a hybrid render uses the fixture's model unless tweak sets another).
+Rendered render_bunny(const Fixture& f, bool hybrid, const Tweak& tweak = nullptr) {
     vk::ContextOptions co;
     co.device = vk::DeviceChoice::cpu;
     co.validation = true;
@@ -64,21 +62,23 @@ Rendered render_bunny(const Fixture& f, bool hybrid, NeuralPath path = NeuralPat
     o.seed = 7;
     o.neural.roughness = 0.6f;
     o.neural.metallic = 0.0f;
-    o.neural.path = path;
-    o.neural.threshold = threshold;
-    o.neural.lod = lod;
-    o.neural.secondary_lod = secondary_lod;
-    o.neural.batched_rounds = batched_rounds;
-    o.neural.leaves_per_round = leaves_per_round;
-    o.neural.max_rounds = max_leaves;
-    o.sort_rays = sort_rays;
-    o.neural.occupancy = occupancy;
-    if (hybrid) o.neural.model = model ? model : &f.model;
+    o.neural.path = NeuralPath::scalar;
+    o.neural.secondary_lod = SECONDARY_LOD_SAME;
+    if (hybrid) o.neural.model = &f.model;
     else o.neural.classical = true;
     if (tweak) tweak(o);
     WavefrontRenderer r(ctx, f.scene, accel, default_sky(), cam, o);
     RenderResult res = r.render();
     return {convert_channels(res.image, 3), res.stats, ctx.validation_message_count()};
+}
+
+// Batched rounds, leaves per round and the per-ray leaf budget.
+Tweak rounds(uint32_t batched, uint32_t leaves_per_round, uint32_t max_leaves = NeuralRenderOptions{}.max_rounds) {
+    return [=](RenderOptions& o) {
+        o.neural.batched_rounds = batched;
+        o.neural.leaves_per_round = leaves_per_round;
+        o.neural.max_rounds = max_leaves;
+    };
 }
 
 } // namespace
@@ -104,7 +104,7 @@ TEST(HybridRender, BunnyMatchesClassicalReference) {
     EXPECT_LT(flip, FLIP_BOUND);
 
     // Negative control: nothing is visible at threshold 0.999, the bunny disappears.
-    const Rendered gone = render_bunny(f, true, NeuralPath::scalar, 0.999f);
+    const Rendered gone = render_bunny(f, true, [](RenderOptions& o) { o.neural.threshold = 0.999f; });
     const float flip_gone = flip_hdr(classical.image, gone.image).mean;
     std::printf("negative control (threshold 0.999): HDR-FLIP %.4f\n", flip_gone);
     EXPECT_GT(flip_gone, FLIP_BOUND);
@@ -116,8 +116,11 @@ TEST(HybridRender, LevelOfDetailOptions) {
     NBVH_REQUIRE_SHARED();
     const Fixture& f = trained_bunny();
     const Rendered classical = render_bunny(f, false);
-    const Rendered coarse = render_bunny(f, true, NeuralPath::scalar, 0.5f, 1, 1);
-    const Rendered mixed = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, 1);
+    const Rendered coarse = render_bunny(f, true, [](RenderOptions& o) {
+        o.neural.lod = 1;
+        o.neural.secondary_lod = 1;
+    });
+    const Rendered mixed = render_bunny(f, true, [](RenderOptions& o) { o.neural.secondary_lod = 1; });
     EXPECT_EQ(coarse.validation + mixed.validation, 0);
     EXPECT_EQ(coarse.stats.nonfinite_pixels + mixed.stats.nonfinite_pixels, 0u);
     const float fc = flip_hdr(classical.image, coarse.image).mean;
@@ -134,9 +137,9 @@ TEST(HybridRender, LevelOfDetailOptions) {
 TEST(HybridRender, TailPassMatchesBatchedRounds) {
     NBVH_REQUIRE_SHARED();
     const Fixture& f = trained_bunny();
-    const Rendered all_batched = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 16, 1);
-    const Rendered one = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 1, 1);
-    const Rendered tail = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 0, 1);
+    const Rendered all_batched = render_bunny(f, true, rounds(16, 1));
+    const Rendered one = render_bunny(f, true, rounds(1, 1));
+    const Rendered tail = render_bunny(f, true, rounds(0, 1));
     EXPECT_EQ(all_batched.validation + one.validation + tail.validation, 0);
     const float f1 = flip_hdr(all_batched.image, one.image).mean;
     const float f0 = flip_hdr(all_batched.image, tail.image).mean;
@@ -156,9 +159,9 @@ TEST(HybridRender, TailPassMatchesBatchedRounds) {
 TEST(HybridRender, LeafCapCounterCountsTruncatedRays) {
     NBVH_REQUIRE_SHARED();
     const Fixture& f = trained_bunny();
-    const Rendered cap1 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 1, 1);
-    const Rendered cap1_tail = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 0, 1, 1);
-    const Rendered cap256 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 4, 256);
+    const Rendered cap1 = render_bunny(f, true, rounds(256, 1, 1));
+    const Rendered cap1_tail = render_bunny(f, true, rounds(0, 1, 1));
+    const Rendered cap256 = render_bunny(f, true, rounds(256, 4, 256));
     EXPECT_EQ(cap1.validation + cap1_tail.validation + cap256.validation, 0);
     std::printf("leaf-cap rays: budget 1: %llu (tail: %llu), budget 256: %llu of %llu rays\n",
                 (unsigned long long)cap1.stats.neural_leaf_cap_rays,
@@ -177,10 +180,10 @@ TEST(HybridRender, LeafCapCounterCountsTruncatedRays) {
 TEST(HybridRender, LeavesPerRoundKeepTheImage) {
     NBVH_REQUIRE_SHARED();
     const Fixture& f = trained_bunny();
-    const Rendered k1 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 1);
-    const Rendered k2 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 2);
-    const Rendered k4 = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 256, 4);
-    const Rendered k4_tail = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, 1, 4);
+    const Rendered k1 = render_bunny(f, true, rounds(256, 1));
+    const Rendered k2 = render_bunny(f, true, rounds(256, 2));
+    const Rendered k4 = render_bunny(f, true, rounds(256, 4));
+    const Rendered k4_tail = render_bunny(f, true, rounds(1, 4));
     EXPECT_EQ(k1.validation + k2.validation + k4.validation + k4_tail.validation, 0);
     const float f2 = flip_hdr(k1.image, k2.image).mean;
     const float f4 = flip_hdr(k1.image, k4.image).mean;
@@ -206,8 +209,16 @@ TEST(HybridRender, SortedRaysKeepTheImage) {
     const Fixture& f = trained_bunny();
     for (uint32_t k : {1u, 2u})
         for (uint32_t batched : {256u, 1u}) {
-            const Rendered plain = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, 1, batched, k, 8, false);
-            const Rendered sorted = render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, 1, batched, k, 8, true);
+            const Rendered plain = render_bunny(f, true, [&](RenderOptions& o) {
+                rounds(batched, k, 8)(o);
+                o.neural.secondary_lod = 1;
+                o.sort_rays = false;
+            });
+            const Rendered sorted = render_bunny(f, true, [&](RenderOptions& o) {
+                rounds(batched, k, 8)(o);
+                o.neural.secondary_lod = 1;
+                o.sort_rays = true;
+            });
             EXPECT_EQ(plain.validation + sorted.validation, 0);
             std::printf("%u leaves per round, %u batched rounds: queries %llu / %llu (queue order / sorted)\n", k, batched,
                         (unsigned long long)plain.stats.neural_queries, (unsigned long long)sorted.stats.neural_queries);
@@ -255,10 +266,11 @@ TEST(HybridRender, OccupancyMasksSkipEmptyLeaves) {
     NBVH_REQUIRE_SHARED();
     const Fixture& f = trained_bunny();
     ASSERT_EQ(f.model.occupancy.size(), f.model.nodes.size() * NB_OCC_WORDS);
-    const NeuralRenderOptions d;
     auto render = [&](bool occupancy, const NeuralModel* m) {
-        return render_bunny(f, true, NeuralPath::scalar, 0.5f, 0, -1, d.batched_rounds, d.leaves_per_round,
-                            d.max_rounds, RenderOptions{}.sort_rays, occupancy, m);
+        return render_bunny(f, true, [&](RenderOptions& o) {
+            o.neural.occupancy = occupancy;
+            if (m) o.neural.model = m;
+        });
     };
     const Rendered classical = render_bunny(f, false);
     const Rendered off = render(false, nullptr);
@@ -295,13 +307,11 @@ TEST(HybridRender, OccupancyMasksSkipEmptyLeaves) {
 TEST(HybridRender, BackfaceEscapeLeavesTheAsset) {
     NBVH_REQUIRE_SHARED();
     const Fixture& f = trained_bunny();
-    const NeuralRenderOptions d;
     auto render = [&](bool hybrid, bool escape) {
-        return render_bunny(f, hybrid, NeuralPath::scalar, 0.5f, 0, -1, d.batched_rounds, d.leaves_per_round,
-                            d.max_rounds, RenderOptions{}.sort_rays, true, nullptr, [escape](RenderOptions& o) {
-                                o.max_depth = 8;
-                                o.neural.backface_escape = escape;
-                            });
+        return render_bunny(f, hybrid, [escape](RenderOptions& o) {
+            o.max_depth = 8;
+            o.neural.backface_escape = escape;
+        });
     };
     const Rendered classical = render(false, true), on = render(true, true), off = render(true, false);
     auto deep = [](const Rendered& r) { // path rays of bounces 3 and deeper
