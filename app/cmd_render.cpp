@@ -20,6 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/build_info.h"
 #include "app/commands.h"
 #include "app/output_path.h"
 #include "app/render_args.h"
@@ -45,6 +46,7 @@ struct RenderArgs {
     std::string model, neural_path = "auto", neural_glob, texture_path = "auto", secondary_lod = "coarsest";
     render::RenderOptions options;
     bool explain = false;
+    std::string command_line; // as typed, written into --stats
 };
 
 // The exposure of the written image: PNG gets --exposure (auto: from the image), EXR stays linear.
@@ -53,10 +55,39 @@ struct Exposure {
     float stops = 0.0f;
 };
 
-void write_stats(const std::string& path, const render::RenderStats& s, const std::string& scene,
-                 const Exposure& exposure) {
+// What produced a --stats file: the binary's commit, the command and the settings that change the work
+// or the image (defaults included, so that a results file says what "default" meant at its commit).
+nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o) {
+    nlohmann::json j = {{"seed", o.seed},
+                        {"rr_start_depth", o.rr_start_depth},
+                        {"sort_rays", o.sort_rays},
+                        {"max_wave_pixels", o.max_wave_pixels},
+                        {"texture_path", a.texture_path}};
+    if (o.neural.model) {
+        const render::NeuralRenderOptions& n = o.neural;
+        j["neural"] = {{"model", a.model},
+                       {"lod", n.lod},
+                       {"secondary_lod", a.secondary_lod},
+                       {"visibility_threshold", n.threshold},
+                       {"max_leaves", n.max_rounds},
+                       {"leaves_per_round", n.leaves_per_round},
+                       {"batched_rounds", n.batched_rounds},
+                       {"occupancy", n.occupancy},
+                       {"backface_escape", n.backface_escape},
+                       {"roughness_override", n.roughness},
+                       {"metallic_override", n.metallic}};
+    }
+    j["classical_reference"] = o.neural.classical;
+    return j;
+}
+
+void write_stats(const std::string& path, const render::RenderStats& s, const RenderArgs& a,
+                 const render::RenderOptions& options, const Exposure& exposure) {
     nlohmann::json j;
-    j["scene"] = scene;
+    j["commit"] = build_commit();
+    j["command_line"] = a.command_line;
+    j["settings"] = settings_json(a, options);
+    j["scene"] = a.scene;
     j["device"] = s.device;
     j["driver"] = s.driver;
     j["width"] = s.width;
@@ -168,15 +199,16 @@ void run_render(const RenderArgs& a) {
         enc.exposure = exposure.stops;
         save_png(a.out, result.image, enc);
     }
-    if (!a.stats.empty()) write_stats(a.stats, s, a.scene, exposure);
+    if (!a.stats.empty()) write_stats(a.stats, s, a, options, exposure);
     if (ctx.validation_enabled() && ctx.validation_message_count() > 0)
         log_warn("render: %d Vulkan validation messages", ctx.validation_message_count());
 }
 
 } // namespace
 
-void add_render_command(CLI::App& app) {
+void add_render_command(CLI::App& app, const std::string& command_line) {
     auto args = std::make_shared<RenderArgs>();
+    args->command_line = command_line;
     auto* cmd = app.add_subcommand("render", "path-trace a glTF scene (or 'default') with the wavefront renderer");
     cmd->add_option("scene", args->scene, "glTF/GLB file, or 'default' for the built-in scene")->required();
     cmd->add_option("--out", args->out, "output image: .png (tone-mapped sRGB) or .exr (linear)");
@@ -191,7 +223,7 @@ void add_render_command(CLI::App& app) {
                     "--stats. EXR output is linear and unscaled");
     cmd->add_option("--env-rotation", args->env_rotation, "rotate the environment about +y by this many degrees")
         ->check(CLI::Range(-3600.0f, 3600.0f));
-    cmd->add_option("--stats", args->stats, "write per-pass GPU times, ray counts and checks as JSON");
+    cmd->add_option("--stats", args->stats, "write per-pass GPU times, ray counts and checks as JSON, with the commit, command line and settings");
     cmd->add_flag("--explain", args->explain, "print the scene's feature set and the passes, then exit");
     cmd->add_option("--model", args->model, "N-BVH model (.nbvh) for the scene's neural instances (hybrid render)");
     cmd->add_flag("--classical", args->options.neural.classical,

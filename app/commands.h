@@ -7,11 +7,11 @@
 
 namespace nbvh::app {
 
-void add_render_command(CLI::App& app);
+// `command_line`: the whole command as typed (written into render's --stats and the benchmark results).
+void add_render_command(CLI::App& app, const std::string& command_line);
 void add_train_command(CLI::App& app);
 void add_flip_command(CLI::App& app);
 void add_info_command(CLI::App& app);
-// `command_line`: the whole command as typed (written into the benchmark results).
 void add_bench_command(CLI::App& app, const std::string& command_line);
 void add_bench_features_command(CLI::App& app, const std::string& command_line);
 void add_study_command(CLI::App& app, const std::string& command_line);

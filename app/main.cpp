@@ -12,11 +12,11 @@
 int main(int argc, char** argv) {
     CLI::App app{"nbvh: ray queries against complex 3D assets answered by a learned N-BVH"};
     app.require_subcommand(1);
-    nbvh::app::add_render_command(app);
+    const std::string command = nbvh::app::command_line(argc, argv);
+    nbvh::app::add_render_command(app, command);
     nbvh::app::add_train_command(app);
     nbvh::app::add_flip_command(app);
     nbvh::app::add_info_command(app);
-    const std::string command = nbvh::app::command_line(argc, argv);
     nbvh::app::add_bench_command(app, command);
     nbvh::app::add_bench_features_command(app, command);
     nbvh::app::add_study_command(app, command);

@@ -132,6 +132,9 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
     p.leaf_budget = stage.rounds();
     p.leaves_per_round = stage.leaves_per_round();
     p.batched_rounds = stage.batched_rounds();
+    p.occupancy = stage.params().occupancy != 0u;
+    p.model_has_masks = !o.model->occupancy.empty();
+    p.backface_escape = o.backface_escape;
     for (const Instance& inst : scene.instances) p.instances += inst.neural;
     p.assets = uint32_t(o.model->assets.size());
     return p;
@@ -201,6 +204,11 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
                     n->lod_primary, n->lod_secondary, n->lod_count);
         s += strfmt("  leaves per ray  at most %u, %u queued per round: %u batched round%s, then neural_tail\n",
                     n->leaf_budget, n->leaves_per_round, n->batched_rounds, n->batched_rounds == 1 ? "" : "s");
+        s += strfmt("  occupancy masks %s\n", n->occupancy          ? "on  (leaves crossing only empty cells are not queried)"
+                                              : n->model_has_masks ? "off (--neural-occupancy off)"
+                                                                   : "off (the model has none: format version < 3)");
+        s += strfmt("  back-face escape %s\n", n->backface_escape ? "on  (rays leaving a hit seen from behind skip back faces)"
+                                                                 : "off (--neural-backface-escape off)");
     } else {
         s += strfmt("  neural assets   %s\n", yn(f.neural));
     }

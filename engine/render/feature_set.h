@@ -67,6 +67,9 @@ struct NeuralPlan {
     uint32_t leaf_budget = 0;      // leaves queried per ray at most (--neural-max-leaves)
     uint32_t leaves_per_round = 0; // leaves a ray queues per round
     uint32_t batched_rounds = 0;   // rounds through the batched query pass before neural_tail
+    bool occupancy = false;        // leaves skipped by the model's occupancy masks (on and the model has them)
+    bool model_has_masks = false;
+    bool backface_escape = false;  // --neural-backface-escape
     uint32_t instances = 0, assets = 0;
 };
 

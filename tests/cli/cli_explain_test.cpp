@@ -31,6 +31,8 @@ TEST(CliExplain, HybridRenderListsTheNeuralPasses) {
     EXPECT_TRUE(has(o, "MLP path        scalar")) << o;
     EXPECT_TRUE(has(o, "camera rays 1, after the first hit 0 (the model has 2")) << o;
     EXPECT_TRUE(has(o, "at most 8, 2 queued per round: 4 batched rounds")) << o; // the defaults
+    EXPECT_TRUE(has(o, "occupancy masks on")) << o;
+    EXPECT_TRUE(has(o, "back-face escape on")) << o;
     for (const char* pass :
          {"passes/neural_traverse.comp", "passes/neural_args.comp", "passes/neural_query_scalar.comp",
           "passes/neural_tail.comp", "passes/neural_shadow.comp", "passes/shade.comp"})
@@ -90,3 +92,14 @@ TEST(CliExplain, ForcedCoopmatOnLavapipeIsTheRendersError) {
 }
 
 } // namespace
+
+TEST(CliExplain, CullingSwitchesAreNamed) {
+    const auto r = run_nbvh(explain({"--model", tiny_model().string(), "--neural-occupancy", "off",
+                                     "--neural-backface-escape", "off"}),
+                            60.0);
+    ASSERT_EQ(r.exit_code, 0) << r.describe();
+    EXPECT_TRUE(has(r.out, "occupancy masks off (--neural-occupancy off)")) << r.out;
+    EXPECT_TRUE(has(r.out, "back-face escape off (--neural-backface-escape off)")) << r.out;
+    const auto bad = run_nbvh(explain({"--model", tiny_model().string(), "--neural-backface-escape", "maybe"}), 60.0);
+    EXPECT_EQ(check_clean_error(bad, {"--neural-backface-escape"}, false), "") << bad.describe();
+}

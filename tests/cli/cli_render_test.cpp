@@ -87,6 +87,7 @@ struct Outcome {
     int64_t non_finite = -1;     // from --stats (-1: no stats file)
     bool dir_clean = true;       // nothing but the image/stats in the output dir (no temp files left)
     bool depth_times = false;    // --stats has pass_gpu_ms_by_depth for the passes of pass_gpu_ms
+    bool provenance = false;     // --stats names the commit, the command line and the settings
 };
 
 Outcome render(const fs::path& scene, const fs::path& dir) {
@@ -103,6 +104,9 @@ Outcome render(const fs::path& scene, const fs::path& dir) {
             o.non_finite = j.at("non_finite_pixels").get<int64_t>();
             const nlohmann::json &passes = j.at("pass_gpu_ms"), &by_depth = j.at("pass_gpu_ms_by_depth");
             o.depth_times = by_depth.size() == passes.size();
+            o.provenance = !j.at("commit").get<std::string>().empty() &&
+                           j.at("command_line").get<std::string>().find("--max-depth 2") != std::string::npos &&
+                           j.at("settings").at("sort_rays").is_boolean() && j.at("settings").at("seed") == 0;
             for (const auto& [name, ms] : passes.items())
                 o.depth_times = o.depth_times && by_depth.contains(name) && by_depth[name].is_array() &&
                                 !by_depth[name].empty() && by_depth[name].size() <= 2; // --max-depth 2
@@ -120,6 +124,7 @@ void expect_rendered(const Outcome& o) {
     EXPECT_TRUE(o.image) << "no output image";
     EXPECT_EQ(o.non_finite, 0) << "non_finite_pixels in --stats (-1: no stats file)";
     EXPECT_TRUE(o.depth_times) << "pass_gpu_ms_by_depth in --stats";
+    EXPECT_TRUE(o.provenance) << "commit, command_line and settings in --stats";
 }
 
 // strict: only "warning: " lines may precede the error (files the loader must reject); otherwise the
