@@ -206,7 +206,7 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
                     n->leaf_budget, n->leaves_per_round, n->batched_rounds, n->batched_rounds == 1 ? "" : "s");
         s += strfmt("  occupancy masks %s\n", n->occupancy          ? "on  (leaves crossing only empty cells are not queried)"
                                               : n->model_has_masks ? "off (--neural-occupancy off)"
-                                                                   : "off (the model has none: format version < 3)");
+                                                                   : "off (the model has no masks: format version < 3 or built without its triangles)");
         s += strfmt("  back-face escape %s\n", n->backface_escape ? "on  (rays leaving a hit seen from behind skip back faces)"
                                                                  : "off (--neural-backface-escape off)");
     } else {
