@@ -64,6 +64,7 @@ struct NeuralRenderOptions {
     // back-facing neural hits, so that it leaves the asset instead of bouncing inside it
     // (NB_RAY_BACKFACE_BIT, engine/render/NEURAL.md). --neural-backface-escape on|off.
     bool backface_escape = true;
+    bool backface_inside = false;  // experiment: NB_RAY_INSIDE_BIT
 };
 
 // Leaves per round of `options` (throws nbvh::Error when out of range).

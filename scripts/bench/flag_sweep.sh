@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Frame times of render-flag variants of one binary in one GPU call (issue 14): the default scene and the
-# dragon, models trained once by the binary's default `nbvh train`, then per scene a warm-up and REPS
+# Frame times of render-flag variants of one binary in one GPU call (issue 14): the scenes of SCENES (default:
+# the default scene and the dragon; chess too), models trained once by the binary's default `nbvh train`,
+# then per scene a warm-up and REPS
 # interleaved rounds over the variants (clocks and caches drift alike), 1920x1080, 16 spp, max depth 8,
 # same seed. Reports the fastest render of each variant in ms per sample, per-pass times, and the FLIP
 # of each variant's image against the first variant's. Writes OUT/sweep.json and prints a table.
@@ -9,25 +10,30 @@
 # Env: NBVH (binary, default .device/study/bin/nbvh), VARIANTS (lines NAME|FLAGS: hybrid flags, or
 #      "classical FLAGS" for a classical variant; the classical render of each scene with no flags is
 #      always added as "classical"; FLIP compares each variant with the first), REPS (default 2), SPP (16),
-#      DRAGON (xz-packed glb, default .device/study/dragon/dragon_vrip.glb.xz), WIDTH, HEIGHT,
+#      SCENES (default "default dragon"; chess needs .device/study/chess carried), DRAGON (xz-packed glb,
+#      default .device/study/dragon/dragon_vrip.glb.xz), WIDTH, HEIGHT,
 #      TRAIN_ARGS (extra `nbvh train` flags, e.g. a short CPU training for a dry run).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
+source scripts/bench/lib.sh
 OUT=$1
 B=${NBVH:-.device/study/bin/nbvh}
-DRAGON=${DRAGON:-.device/study/dragon/dragon_vrip.glb.xz}
 T=${TMPDIR:-/tmp}/nbvh_sweep
 mkdir -p "$OUT" "$T"
-python3 -c 'import lzma, shutil, sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2], "wb"))' "$DRAGON" "$T/dragon.glb"
 (nvidia-smi --query-gpu=name,driver_version --format=csv,noheader || echo "no nvidia-smi") | tee "$OUT/device.txt"
 # shellcheck disable=SC2206
 TA=(${TRAIN_ARGS:-})
-"$B" train default "${TA[@]}" --out "$T/default.nbvh" > "$OUT/train_default.log" 2>&1
-"$B" train "$T/dragon.glb" --neural '*' "${TA[@]}" --out "$T/dragon.nbvh" > "$OUT/train_dragon.log" 2>&1
+# shellcheck disable=SC2206
+SC=(${SCENES:-default dragon})
+for scene in "${SC[@]}"; do
+  bench_scene "$scene" "$T"
+  "$B" train "${SRC[@]}" "${NEURAL[@]}" "${TA[@]}" --out "$T/$scene.nbvh" > "$OUT/train_$scene.log" 2>&1
+done
 R=(--width "${WIDTH:-1920}" --height "${HEIGHT:-1080}" --max-depth 8 --exposure 0 --spp "${SPP:-16}")
 mapfile -t V <<< "${VARIANTS:?VARIANTS: lines NAME|FLAGS}"
-for scene in default dragon; do
-  if [ $scene = default ]; then S=(default); C=(--classical); else S=("$T/dragon.glb"); C=(--neural '*' --classical); fi
+for scene in "${SC[@]}"; do
+  bench_scene "$scene" "$T"
+  S=("${SRC[@]}" "${VIEW[@]}"); C=("${NEURAL[@]}" --classical)
   "$B" render "${S[@]}" --model "$T/$scene.nbvh" "${R[@]}" --out "$T/warm.png" > /dev/null 2>&1
   for rep in $(seq "${REPS:-2}"); do
     "$B" render "${S[@]}" "${C[@]}" "${R[@]}" --out "$T/${scene}_classical.png" --stats "$OUT/${scene}_classical_$rep.json" > /dev/null 2>&1

@@ -5,10 +5,11 @@
 # each hybrid variant (seed 0) at FLIP_W x FLIP_H, and their FLIPs against the reference and against
 # the classical render of the same seed (OUT/flips.txt; stats of each render in OUT/SCENE_flip_NAME.json).
 # Usage (GPU machine, after `source .device/env.sh`): VARIANTS=$'off|--neural-occupancy off\non|' scripts/bench/variant_flips.sh OUT
-# Env: as flag_sweep.sh, plus FLIP_W (960), FLIP_H (540), FLIP_SPP (2048). The occupancy A/B of
+# Env: as flag_sweep.sh (SCENES among them), plus FLIP_W (960), FLIP_H (540), FLIP_SPP (2048). The occupancy A/B of
 # results/perf/ab_occupancy_h100.json is the VARIANTS above with REPS=3.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
+source scripts/bench/lib.sh
 OUT=$1
 mkdir -p "$OUT"
 REPS=${REPS:-3} scripts/bench/flag_sweep.sh "$OUT/sweep" > "$OUT/sweep.txt" 2>&1 || echo sweep failed
@@ -16,8 +17,11 @@ T=${TMPDIR:-/tmp}/nbvh_sweep
 B=${NBVH:-.device/study/bin/nbvh}
 R=(--width "${FLIP_W:-960}" --height "${FLIP_H:-540}" --max-depth 8 --exposure 0 --spp "${FLIP_SPP:-2048}")
 mapfile -t V <<< "${VARIANTS:?VARIANTS: lines NAME|FLAGS}"
-for scene in default dragon; do
-  if [ $scene = default ]; then S=(default); C=(--classical); else S=("$T/dragon.glb"); C=(--neural '*' --classical); fi
+# shellcheck disable=SC2206
+SC=(${SCENES:-default dragon})
+for scene in "${SC[@]}"; do
+  bench_scene "$scene" "$T"
+  S=("${SRC[@]}" "${VIEW[@]}"); C=("${NEURAL[@]}" --classical)
   $B render "${S[@]}" "${C[@]}" "${R[@]}" --seed 7 --out "$T/${scene}_ref.png" > /dev/null 2>&1
   $B render "${S[@]}" "${C[@]}" "${R[@]}" --out "$T/${scene}_cl.png" > /dev/null 2>&1
   line="$scene floor(classical vs ref) $($B flip "$T/${scene}_ref.png" "$T/${scene}_cl.png" | tail -1)"
