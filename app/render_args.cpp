@@ -33,11 +33,10 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
            "(on, default; models without masks query every leaf) or query every leaf (off)")
         ->check(CLI::IsMember({"on", "off"}));
     cmd->add_option_function<std::string>(
-           "--neural-backface-escape", [&o](const std::string& v) { o.neural.backface_escape = v != "off"; o.neural.backface_inside = v == "inside"; },
+           "--neural-backface-escape", [&o](const std::string& v) { o.neural.backface_escape = v == "on"; },
            "a ray leaving a neural hit seen from behind skips back-facing neural hits, so that it leaves the "
-           "asset (on, default) or bounces on inside it (off: the paper's and the official code's behaviour); inside: experiment, "
-           "a path seen from behind twice in a row skips back faces in every leaf")
-        ->check(CLI::IsMember({"on", "off", "inside"}));
+           "asset (on, default) or bounces on inside it (off: the paper's and the official code's behaviour)")
+        ->check(CLI::IsMember({"on", "off"}));
     cmd->add_option_function<std::string>(
            "--sort-rays", [&o](const std::string& v) { o.sort_rays = v == "on"; },
            "trace secondary and shadow rays grouped by direction and origin (on, default) "

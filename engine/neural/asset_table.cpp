@@ -124,6 +124,7 @@ AssetShading asset_shading(const Scene& scene, uint32_t mesh) {
     const Material& material = scene.materials[mat];
     s.metallic = std::clamp(material.metallic, 0.0f, 1.0f);
     s.roughness = std::clamp(material.roughness, 0.0f, 1.0f);
+    s.transmission = std::clamp(material.transmission, 0.0f, 1.0f);
     const TextureRef& ref = material.metallic_roughness_tex;
     const std::vector<glm::vec2>& uvs = ref.uv_set == 1u ? m.uv1 : m.uv0;
     if (ref.texture < 0 || size_t(ref.texture) >= scene.textures.size() || uvs.size() != m.positions.size()) return s;

@@ -33,8 +33,9 @@ ModelAsset describe_asset(const Scene& scene, uint32_t mesh);
 // are multiplied by the metallic-roughness texture averaged over the mesh's surface (area-weighted,
 // sampled at 4 points per triangle). Without a texture: the factors. (The paper shades neural hits with
 // global constants; LSNIF predicts material parameters; the albedo here is learned, these are not.)
+// Transmission: the material's factor (a transmissive asset is seen from inside: no back-face escape).
 struct AssetShading {
-    float metallic = 0.0f, roughness = 1.0f;
+    float metallic = 0.0f, roughness = 1.0f, transmission = 0.0f;
 };
 AssetShading asset_shading(const Scene& scene, uint32_t mesh);
 

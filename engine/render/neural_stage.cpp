@@ -122,13 +122,17 @@ std::vector<GpuNeuralAsset> NeuralStage::asset_table(const NeuralModel& model, c
         g.material = 0;
         g.metallic = 0.0f;
         g.roughness = 1.0f;
-        g.backface_escape = o.backface_escape ? (o.backface_inside ? 2u : 1u) : 0u;
+        g.backface_escape = o.backface_escape ? 1u : 0u;
         for (uint32_t m = 0; m < scene.meshes.size(); ++m)
             if (asset_of_mesh(model, scene, m) == int32_t(a) && !scene.meshes[m].triangle_material.empty()) {
                 g.material = scene.meshes[m].triangle_material[0];
                 const AssetShading sh = asset_shading(scene, m);
                 g.metallic = sh.metallic;
                 g.roughness = sh.roughness;
+                // Refracted rays see a transmissive asset's surface from inside, and internally
+                // reflected ones must stay inside: no escape there (Chess's glass pawn tops,
+                // results/perf/README.md).
+                if (sh.transmission > 0.0f) g.backface_escape = 0u;
                 break;
             }
         if (g.material >= std::max<size_t>(scene.materials.size(), 1)) g.material = 0;

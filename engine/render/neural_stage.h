@@ -64,7 +64,6 @@ struct NeuralRenderOptions {
     // back-facing neural hits, so that it leaves the asset instead of bouncing inside it
     // (NB_RAY_BACKFACE_BIT, engine/render/NEURAL.md). --neural-backface-escape on|off.
     bool backface_escape = true;
-    bool backface_inside = false;  // experiment: NB_RAY_INSIDE_BIT
 };
 
 // Leaves per round of `options` (throws nbvh::Error when out of range).
@@ -115,11 +114,12 @@ public:
     uint32_t batched_rounds() const { return batched_; }
     uint32_t leaves_per_round() const { return params_.leaves_per_round; }
     const GpuNeuralParams& params() const { return params_; }
+    const std::vector<GpuNeuralAsset>& assets() const { return assets_; }
 
 private:
     void set_params(const NeuralRenderOptions& options);
     // The asset table: each asset's subtree root per LoD, the material of the scene mesh it answers
-    // and the options' back-face escape.
+    // and the options' back-face escape (off for a transmissive material).
     static std::vector<GpuNeuralAsset> asset_table(const NeuralModel& model, const NeuralModelGpu& gpu,
                                                    const Scene& scene, const NeuralRenderOptions& options);
     void install_model(std::vector<vk::Buffer>& buffers);

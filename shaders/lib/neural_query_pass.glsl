@@ -50,13 +50,12 @@ float nb_neural_pair_hit(NbPendingQuery r, float y[NB_MLP_OUTPUTS], out vec3 nor
     bool shadow = ray >= cap;
     float tmin = shadow ? 0.0f : uintBitsToFloat(ray_load1(pc.in_queue, NB_RAY_T_RESUME, ray));
     float tmax = shadow ? uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, ray - cap)) : NB_INF;
-    uint fw = shadow ? shadow_load1(NB_SHADOW_PIXEL, ray - cap) : ray_load1(pc.in_queue, NB_RAY_DEPTH, ray);
-    bool flagged = (fw & NB_RAY_BACKFACE_BIT) != 0u;
-    bool inside = (fw & NB_RAY_INSIDE_BIT) != 0u;
+    bool flagged = ((shadow ? shadow_load1(NB_SHADOW_PIXEL, ray - cap) : ray_load1(pc.in_queue, NB_RAY_DEPTH, ray)) &
+                    NB_RAY_BACKFACE_BIT) != 0u;
     normal = vec3(0.0f, 0.0f, 1.0f);
     albedo = h.albedo;
     if ((h.flags & (NB_NEURAL_VISIBLE | NB_NEURAL_ACCEPTED)) == (NB_NEURAL_VISIBLE | NB_NEURAL_ACCEPTED) &&
-        h.t > tmin && h.t < tmax && !nb_backface_skip(flagged, shadow || inside, nb_query_reversed(r.pl.t_enter), h.normal, r.dir)) {
+        h.t > tmin && h.t < tmax && !nb_backface_skip(flagged, shadow, nb_query_reversed(r.pl.t_enter), h.normal, r.dir)) {
         vec3 n = nb_xform_normal(instances[r.pl.instance].world_to_object, h.normal);
         float len = length(n);
         normal = len > 0.0f ? n / len : vec3(0.0f, 0.0f, 1.0f);

@@ -35,9 +35,9 @@ Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t) {
 // True when the rays leaving neural hit `ray` skip back-facing neural hits: the hit's asset has
 // backface_escape and its predicted normal faces along the incoming ray (shared/neural_query.h
 // nb_backface_skip).
-uint nb_neural_escapes(uint ray, vec3 ray_dir) {
+bool nb_neural_escapes(uint ray, vec3 ray_dir) {
     GpuNeuralRayState st = neural_state[ray];
-    return nb_faces_along(st.normal, ray_dir, 0.0f) ? neural_assets[instances[st.instance].blas_root].backface_escape : 0u;
+    return neural_assets[instances[st.instance].blas_root].backface_escape != 0u && nb_faces_along(st.normal, ray_dir, 0.0f);
 }
 
 #endif

@@ -46,7 +46,7 @@ void main() {
     vec3 org = shadow_load3(NB_SHADOW_ORIGIN, i);
     vec3 dir = shadow_load3(NB_SHADOW_DIR, i);
     float tmax = uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, i));
-    g_alpha_seed = nb_shadow_alpha_seed(shadow_load1(NB_SHADOW_PIXEL, i) & ~NB_RAY_FLAG_BITS);
+    g_alpha_seed = nb_shadow_alpha_seed(shadow_load1(NB_SHADOW_PIXEL, i) & ~NB_RAY_BACKFACE_BIT);
     nb_nl_begin(st, neural_params.lod_secondary, nb_nl_want(st));
     g_nl_skip_triangles = op != 0u;
     nb_trace(org, dir, 0.0f, tmax, true);

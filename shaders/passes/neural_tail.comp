@@ -33,7 +33,7 @@ void main() {
     vec3 dir = shadow ? shadow_load3(NB_SHADOW_DIR, i) : ray_load3(pc.in_queue, NB_RAY_DIR, i);
     float tmin = shadow ? 0.0f : uintBitsToFloat(ray_load1(pc.in_queue, NB_RAY_T_RESUME, i));
     float tmax = shadow ? uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, i)) : NB_INF;
-    g_alpha_seed = shadow ? nb_shadow_alpha_seed(shadow_load1(NB_SHADOW_PIXEL, i) & ~NB_RAY_FLAG_BITS)
+    g_alpha_seed = shadow ? nb_shadow_alpha_seed(shadow_load1(NB_SHADOW_PIXEL, i) & ~NB_RAY_BACKFACE_BIT)
                           : ray_load1(pc.in_queue, NB_RAY_RNG, i);
     uint lod = (shadow || pc.depth != 0u) ? neural_params.lod_secondary : neural_params.lod_primary;
     GpuNeuralRayState st = neural_state[ray];

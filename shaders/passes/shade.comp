@@ -26,8 +26,7 @@ void main() {
     vec3 dir = ray_load3(q, NB_RAY_DIR, i);
     vec3 throughput = ray_load3(q, NB_RAY_THROUGHPUT, i);
     uint slot = ray_load1(q, NB_RAY_PIXEL, i);
-    uint depth_word = ray_load1(q, NB_RAY_DEPTH, i);
-    uint depth = depth_word & ~NB_RAY_FLAG_BITS;
+    uint depth = ray_load1(q, NB_RAY_DEPTH, i) & ~NB_RAY_BACKFACE_BIT;
     uint rng = ray_load1(q, NB_RAY_RNG, i);
     float prev_pdf = uintBitsToFloat(ray_load1(q, NB_RAY_PDF, i));
     float p_env, p_emissive, p_punctual;
@@ -48,9 +47,7 @@ void main() {
                                                                    : nb_make_surface(instance, tri_index, hit_load_bary(i), org, dir, t);
     vec3 wo = -dir;
     // Rays leaving a neural hit seen from behind skip back-facing neural hits (NB_RAY_BACKFACE_BIT).
-    uint mode = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE) ? nb_neural_escapes(i, dir) : 0u;
-    uint escape = mode != 0u ? NB_RAY_BACKFACE_BIT : 0u;
-    if (mode > 1u && (depth_word & NB_RAY_BACKFACE_BIT) != 0u) escape |= NB_RAY_INSIDE_BIT;
+    uint escape = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE && nb_neural_escapes(i, dir)) ? NB_RAY_BACKFACE_BIT : 0u;
 
     if (NB_HAS_EMISSION && dot(s.emission, s.emission) > 0.0f) {
         float w = 1.0f;

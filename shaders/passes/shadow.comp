@@ -13,7 +13,7 @@ void main() {
     vec3 org = shadow_load3(NB_SHADOW_ORIGIN, i);
     vec3 dir = shadow_load3(NB_SHADOW_DIR, i);
     float tmax = uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, i));
-    uint slot = shadow_load1(NB_SHADOW_PIXEL, i) & ~NB_RAY_FLAG_BITS;
+    uint slot = shadow_load1(NB_SHADOW_PIXEL, i) & ~NB_RAY_BACKFACE_BIT;
     g_alpha_seed = nb_shadow_alpha_seed(slot);
     bool occluded;
     if (NB_HAS_NEURAL && (pc.mode & NB_SHADOW_MODE_HYBRID) != 0u) {

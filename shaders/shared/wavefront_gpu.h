@@ -55,8 +55,6 @@ NB_FN uint nb_hit_word(uint field, uint capacity, uint index, uint components) {
 // asset with backface_escape (neural_gpu.h): its neural queries skip back-facing hits (neural_query.h
 // nb_backface_skip). Depths and slots stay far below 2^31; readers mask the bit off.
 #define NB_RAY_BACKFACE_BIT 0x80000000u
-#define NB_RAY_INSIDE_BIT 0x40000000u
-#define NB_RAY_FLAG_BITS 0xC0000000u
 
 NB_FN uint nb_shadow_word(uint field, uint capacity, uint index, uint components) {
     return field * capacity + index * components;

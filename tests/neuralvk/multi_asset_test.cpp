@@ -19,6 +19,7 @@
 #include "engine/core/flip.h"
 #include "engine/core/image.h"
 #include "engine/neural/asset_table.h"
+#include "engine/render/neural_stage.h"
 #include "engine/render/wavefront.h"
 #include "engine/scene/environment.h"
 #include "trainer/evaluation.h"
@@ -256,6 +257,28 @@ TEST(MultiAsset, HybridMatchesTheTrueSceneOnEveryInstance) {
     for (const char* name : {"brick_a", "pillar"}) {
         std::printf("swapped: node %-8s FLIP %.3f\n", name, bad.at(name));
         EXPECT_GT(bad.at(name), NODE_FLIP_BOUND) << name;
+    }
+}
+
+// The back-face escape is per asset: a transmissive asset is seen from inside by its refracted rays, so
+// it keeps every back-facing hit; the others escape unless the option is off.
+TEST(MultiAsset, BackfaceEscapeIsOffForTransmissiveAssets) {
+    const Trained& t = trained();
+    Scene scene = make_scene();
+    scene.materials[2].transmission = 1.0f; // the pillar (green)
+    const std::vector<int32_t> asset_of = bind_model_to_scene(scene, t.model, "m.nbvh");
+    int32_t pillar = -1;
+    for (uint32_t m = 0; m < scene.meshes.size(); ++m)
+        if (scene.meshes[m].name == "pillar") pillar = asset_of[m];
+    ASSERT_GE(pillar, 0);
+    vk::Context ctx(lavapipe());
+    for (bool on : {true, false}) {
+        NeuralRenderOptions o;
+        o.backface_escape = on;
+        const NeuralStage stage(ctx, t.model, scene, o, 64);
+        ASSERT_EQ(stage.assets().size(), t.model.assets.size());
+        for (uint32_t a = 0; a < stage.assets().size(); ++a)
+            EXPECT_EQ(stage.assets()[a].backface_escape, (on && int32_t(a) != pillar) ? 1u : 0u) << "asset " << a;
     }
 }
 
