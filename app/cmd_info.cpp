@@ -66,11 +66,12 @@ void print_model(const std::string& path) {
     const render::NeuralGpuBytes b = render::neural_gpu_bytes(m);
     const uint64_t neural = b.total();
     std::printf("memory       %s on the GPU (grid %s, mlp %s + its transposed copy, nodes of %zu LoD(s) %s + bounds "
-                "%s, occupancy masks %s, level table %s, asset table %s); with LoD 0 alone %s\n",
+                "%s, occupancy masks %s, node materials %s, level table %s, asset table %s); with LoD 0 alone %s\n",
                 human_bytes(double(neural)).c_str(), human_bytes(double(b.grid)).c_str(),
                 human_bytes(double(b.mlp)).c_str(), b.lod_nodes.size(), human_bytes(double(b.nodes)).c_str(),
                 human_bytes(double(b.node_bounds)).c_str(),
                 b.occupancy ? human_bytes(double(b.occupancy)).c_str() : "none (model before format version 3)",
+                b.materials ? human_bytes(double(b.materials)).c_str() : "none (model before format version 4)",
                 human_bytes(double(b.levels)).c_str(),
                 human_bytes(double(b.assets)).c_str(), human_bytes(double(b.total_for_lod(0))).c_str());
     if (m.meta.source_triangles > 0) {

@@ -73,6 +73,7 @@ nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o
                        {"leaves_per_round", n.leaves_per_round},
                        {"batched_rounds", n.batched_rounds},
                        {"occupancy", n.occupancy},
+                       {"node_materials", n.node_materials},
                        {"backface_escape", n.backface_escape},
                        {"roughness_override", n.roughness},
                        {"metallic_override", n.metallic}};

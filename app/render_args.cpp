@@ -33,6 +33,12 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
            "(on, default; models without masks query every leaf) or query every leaf (off)")
         ->check(CLI::IsMember({"on", "off"}));
     cmd->add_option_function<std::string>(
+           "--neural-materials", [&o](const std::string& v) { o.neural.node_materials = v == "node"; },
+           "metallic and roughness of a neural hit: the mean over the triangles of the N-BVH node that "
+           "answered it (node, default; models before format version 4 have only the asset's) or over "
+           "the whole asset (asset)")
+        ->check(CLI::IsMember({"node", "asset"}));
+    cmd->add_option_function<std::string>(
            "--neural-backface-escape", [&o](const std::string& v) { o.neural.backface_escape = v == "on"; },
            "a ray leaving a neural hit seen from behind skips back-facing neural hits, so that it leaves the "
            "asset (on, default) or bounces on inside it (off: the paper's and the official code's behaviour)")

@@ -115,6 +115,32 @@ uint64_t material_fingerprint(const Scene& scene, uint32_t material) {
     return h == 0 ? 1 : h; // 0 means "unknown"
 }
 
+MaterialSums triangle_texture_sums(const Scene& scene, const Mesh& m, const Material& material, uint32_t t) {
+    MaterialSums out;
+    if (3 * size_t(t) + 2 >= m.indices.size()) return out;
+    const uint32_t* idx = &m.indices[3 * size_t(t)];
+    if (idx[0] >= m.positions.size() || idx[1] >= m.positions.size() || idx[2] >= m.positions.size()) return out;
+    const glm::vec3 p0 = m.positions[idx[0]], p1 = m.positions[idx[1]], p2 = m.positions[idx[2]];
+    const double area = 0.5 * double(glm::length(glm::cross(p1 - p0, p2 - p0)));
+    if (!(area > 0.0) || !std::isfinite(area)) return out;
+    out.area = area;
+    const TextureRef& ref = material.metallic_roughness_tex;
+    const std::vector<glm::vec2>& uvs = ref.uv_set == 1u ? m.uv1 : m.uv0;
+    if (ref.texture < 0 || size_t(ref.texture) >= scene.textures.size() || uvs.size() != m.positions.size()) {
+        out.metallic = out.roughness = area;
+        return out;
+    }
+    static constexpr float POINTS[4][3] = {{1.f / 3, 1.f / 3, 1.f / 3}, {2.f / 3, 1.f / 6, 1.f / 6},
+                                           {1.f / 6, 2.f / 3, 1.f / 6}, {1.f / 6, 1.f / 6, 2.f / 3}};
+    for (const auto& w : POINTS) {
+        const glm::vec2 uv = w[0] * uvs[idx[0]] + w[1] * uvs[idx[1]] + w[2] * uvs[idx[2]];
+        const glm::vec4 c = sample_texture_ref(scene.textures, ref, uv, false, glm::vec4(1.0f));
+        out.metallic += area * 0.25 * double(c.b);
+        out.roughness += area * 0.25 * double(c.g);
+    }
+    return out;
+}
+
 AssetShading asset_shading(const Scene& scene, uint32_t mesh) {
     NBVH_CHECK(mesh < scene.meshes.size());
     const Mesh& m = scene.meshes[mesh];
@@ -128,26 +154,16 @@ AssetShading asset_shading(const Scene& scene, uint32_t mesh) {
     const TextureRef& ref = material.metallic_roughness_tex;
     const std::vector<glm::vec2>& uvs = ref.uv_set == 1u ? m.uv1 : m.uv0;
     if (ref.texture < 0 || size_t(ref.texture) >= scene.textures.size() || uvs.size() != m.positions.size()) return s;
-    double area_sum = 0.0, metal = 0.0, rough = 0.0;
-    static constexpr float POINTS[4][3] = {{1.f / 3, 1.f / 3, 1.f / 3}, {2.f / 3, 1.f / 6, 1.f / 6},
-                                           {1.f / 6, 2.f / 3, 1.f / 6}, {1.f / 6, 1.f / 6, 2.f / 3}};
+    MaterialSums sum;
     for (uint32_t t = 0; t < m.triangle_count(); ++t) {
-        const uint32_t* idx = &m.indices[3 * size_t(t)];
-        if (idx[0] >= m.positions.size() || idx[1] >= m.positions.size() || idx[2] >= m.positions.size()) continue;
-        const glm::vec3 p0 = m.positions[idx[0]], p1 = m.positions[idx[1]], p2 = m.positions[idx[2]];
-        const double area = 0.5 * double(glm::length(glm::cross(p1 - p0, p2 - p0)));
-        if (!(area > 0.0) || !std::isfinite(area)) continue;
-        for (const auto& w : POINTS) {
-            const glm::vec2 uv = w[0] * uvs[idx[0]] + w[1] * uvs[idx[1]] + w[2] * uvs[idx[2]];
-            const glm::vec4 c = sample_texture_ref(scene.textures, ref, uv, false, glm::vec4(1.0f));
-            metal += area * 0.25 * double(c.b);
-            rough += area * 0.25 * double(c.g);
-        }
-        area_sum += area;
+        const MaterialSums x = triangle_texture_sums(scene, m, material, t);
+        sum.area += x.area;
+        sum.metallic += x.metallic;
+        sum.roughness += x.roughness;
     }
-    if (area_sum > 0.0) {
-        s.metallic = std::clamp(float(double(s.metallic) * metal / area_sum), 0.0f, 1.0f);
-        s.roughness = std::clamp(float(double(s.roughness) * rough / area_sum), 0.0f, 1.0f);
+    if (sum.area > 0.0) {
+        s.metallic = std::clamp(float(double(s.metallic) * sum.metallic / sum.area), 0.0f, 1.0f);
+        s.roughness = std::clamp(float(double(s.roughness) * sum.roughness / sum.area), 0.0f, 1.0f);
     }
     return s;
 }

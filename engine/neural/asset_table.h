@@ -34,10 +34,19 @@ ModelAsset describe_asset(const Scene& scene, uint32_t mesh);
 // sampled at 4 points per triangle). Without a texture: the factors. (The paper shades neural hits with
 // global constants; LSNIF predicts material parameters; the albedo here is learned, these are not.)
 // Transmission: the material's factor (a transmissive asset is seen from inside: no back-face escape).
+// Per N-BVH node instead: node_materials.h.
 struct AssetShading {
     float metallic = 0.0f, roughness = 1.0f, transmission = 0.0f;
 };
 AssetShading asset_shading(const Scene& scene, uint32_t mesh);
+
+// Area-weighted sums of one triangle of `mesh` (triangle index `t`): its area and area x the
+// metallic-roughness texture's blue (metallic) and green (roughness) channels, averaged at 4 points
+// (1 without a texture). All zero for a degenerate triangle or out-of-range indices.
+struct MaterialSums {
+    double area = 0.0, metallic = 0.0, roughness = 0.0;
+};
+MaterialSums triangle_texture_sums(const Scene& scene, const Mesh& mesh, const Material& material, uint32_t t);
 
 // Binds a model to a scene: the model's assets decide which instances are neural (every instance of a
 // glTF mesh the model has an asset for), meshes are split by material, and every neural mesh must

@@ -19,7 +19,7 @@
 
 namespace nbvh {
 
-inline constexpr uint32_t MODEL_FORMAT_VERSION = 3; // written; versions 1 (one unnamed asset) and 2 (no OCCU) still read
+inline constexpr uint32_t MODEL_FORMAT_VERSION = 4; // written; versions 1 (one unnamed asset), 2 (no OCCU) and 3 (no MATL) still read
 inline constexpr uint32_t MODEL_MAX_ASSETS = 65536;
 inline constexpr size_t MODEL_MAX_STRING = 4096; // bytes of a name in the file
 
@@ -68,6 +68,9 @@ struct NeuralModel {
     // Occupancy masks (engine/neural/occupancy.h): NB_OCC_WORDS per node, or empty (files before
     // version 3, or models built without the triangles): every leaf is then queried.
     std::vector<uint32_t> occupancy;
+    // Per-node metallic and roughness (engine/neural/node_materials.h): one word per node, or empty
+    // (files before version 4, or models built without the triangles): hits take their asset's.
+    std::vector<uint32_t> node_materials;
     TrainingMetadata meta;
     uint32_t file_version = 0;           // format version of the file it was read from (0: not read)
 
@@ -93,7 +96,7 @@ NeuralModel parse_model(std::span<const uint8_t> bytes, const std::string& name 
 NeuralModel load_model(const std::filesystem::path& path);
 
 // Memory of the neural part as the renderer holds it (nodes as GpuBvhNode of LoD 0, fp16 weights and
-// grid, level table, occupancy masks), in bytes.
+// grid, level table, occupancy masks, node materials), in bytes.
 uint64_t model_gpu_bytes(const NeuralModel& model);
 
 // The classical representation of a mesh as the renderer holds it: positions, normals and one UV set

@@ -22,7 +22,8 @@ constexpr char ID_MLP[4] = {'M', 'L', 'P', ' '};
 constexpr char ID_GRID[4] = {'G', 'R', 'I', 'D'};
 constexpr char ID_META[4] = {'M', 'E', 'T', 'A'};
 constexpr char ID_OCC[4] = {'O', 'C', 'C', 'U'}; // optional, version 3
-constexpr const char* ALL_IDS[] = {ID_CONF, ID_ASSET, ID_LEVELS, ID_LODS, ID_NODES, ID_MLP, ID_GRID, ID_META, ID_OCC};
+constexpr char ID_MATL[4] = {'M', 'A', 'T', 'L'}; // optional, version 4
+constexpr const char* ALL_IDS[] = {ID_CONF, ID_ASSET, ID_LEVELS, ID_LODS, ID_NODES, ID_MLP, ID_GRID, ID_META, ID_OCC, ID_MATL};
 
 constexpr uint8_t NODE_FLAG_FINAL = 1;
 
@@ -229,6 +230,14 @@ std::vector<Section> encode_sections(const NeuralModel& m) {
         w.u32(NB_OCC_WORDS);
         for (uint32_t v : m.occupancy) w.u32(v);
         out.push_back(make(ID_OCC, std::move(b)));
+    }
+    if (!m.node_materials.empty()) {
+        b.clear();
+        Writer w(b);
+        w.u32(uint32_t(m.nodes.size()));
+        w.u32(0);
+        for (uint32_t v : m.node_materials) w.u32(v);
+        out.push_back(make(ID_MATL, std::move(b)));
     }
     return out;
 }
@@ -449,6 +458,19 @@ NeuralModel decode_sections(const std::vector<SectionView>& sections, const std:
             throw Error(r.where() + ": size does not match its node count");
         m.occupancy.resize(size_t(count) * words);
         for (uint32_t& v : m.occupancy) v = r.u32();
+        expect_end(r);
+    }
+    for (const SectionView& s : sections) {
+        if (std::memcmp(s.id, ID_MATL, 4) != 0) continue;
+        Reader r(s.bytes, name + ": section 'MATL'");
+        if (version < 4) throw Error(r.where() + ": node materials need format version 4");
+        const uint32_t count = r.u32();
+        if (r.u32() != 0) throw Error(r.where() + ": reserved field is not zero");
+        if (count != m.nodes.size())
+            throw Error(strfmt("%s: %u nodes, the model has %zu", r.where().c_str(), count, m.nodes.size()));
+        if (r.remaining() != size_t(count) * 4) throw Error(r.where() + ": size does not match its node count");
+        m.node_materials.resize(count);
+        for (uint32_t& v : m.node_materials) v = r.u32(); // every word is a valid unorm16 pair
         expect_end(r);
     }
     validate_assets(m, name);

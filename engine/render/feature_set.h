@@ -70,6 +70,8 @@ struct NeuralPlan {
     bool occupancy = false;        // leaves skipped by the model's occupancy masks (on and the model has them)
     bool model_has_masks = false;
     bool backface_escape = false;  // --neural-backface-escape
+    bool node_materials = false;   // hits shaded with their node's metallic/roughness (on and the model has them)
+    bool model_has_materials = false;
     uint32_t instances = 0, assets = 0;
 };
 

@@ -26,9 +26,10 @@ struct NeuralGpuBytes {
     std::vector<uint64_t> lod_nodes; // ... of each LoD alone
     uint64_t node_bounds = 0;        // two vec3 per N-BVH node
     uint64_t occupancy = 0;          // NB_OCC_WORDS words per N-BVH node (0: the model has no masks)
+    uint64_t materials = 0;          // one word per N-BVH node (0: the model has no node materials)
     uint64_t assets = 0, params = 0; // GpuNeuralAsset table, GpuNeuralParams
     uint64_t total() const {
-        return levels + grid + mlp + mlp_transposed + nodes + node_bounds + occupancy + assets + params;
+        return levels + grid + mlp + mlp_transposed + nodes + node_bounds + occupancy + materials + assets + params;
     }
     // A model that keeps only the cut of `lod` (the others' nodes not uploaded).
     uint64_t total_for_lod(uint32_t lod) const;

@@ -140,11 +140,11 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
     pack_lod_nodes(model, nodes, roots_);
     asset_count_ = uint32_t(model.assets.size());
     nodes_ = vk::make_buffer(ctx, nodes, "nbvh nodes");
-    // vec3 lo, vec3 hi per node as words, then the occupancy masks (shared/neural_occupancy.h) in the
-    // same buffer (the set has no binding to spare: lavapipe allows 32 storage buffers per stage);
-    // models without masks have none.
+    // vec3 lo, vec3 hi per node as words, then the occupancy masks (shared/neural_occupancy.h) and the
+    // node materials (node_materials.h) in the same buffer (the set has no binding to spare: lavapipe
+    // allows 32 storage buffers per stage); models without them have none.
     std::vector<uint32_t> words;
-    words.reserve(model.nodes.size() * 6 + model.occupancy.size());
+    words.reserve(model.nodes.size() * 6 + model.occupancy.size() + model.node_materials.size());
     for (const NbvhNode& n : model.nodes)
         for (const glm::vec3& v : {n.bounds.lo, n.bounds.hi})
             for (int k = 0; k < 3; ++k) words.push_back(floatBitsToUint(v[k]));
@@ -152,7 +152,11 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
         occupancy_offset_ = uint32_t(words.size());
         words.insert(words.end(), model.occupancy.begin(), model.occupancy.end());
     }
-    leaf_bounds_ = vk::make_buffer(ctx, words, "nbvh node bounds and occupancy");
+    if (model.node_materials.size() == model.nodes.size()) {
+        materials_offset_ = uint32_t(words.size());
+        words.insert(words.end(), model.node_materials.begin(), model.node_materials.end());
+    }
+    leaf_bounds_ = vk::make_buffer(ctx, words, "nbvh node bounds, occupancy and materials");
     box_ = encoding_box_of(model);
     bytes_ = levels_.size() + grid_.size() + mlp_.size() + mlp_t_.size() + nodes_.size() + leaf_bounds_.size();
 }

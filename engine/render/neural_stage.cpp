@@ -176,6 +176,7 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     params_.threshold = o.threshold;
     params_.max_rounds = o.max_rounds;
     params_.occupancy = o.occupancy ? model_.occupancy_offset() : 0u;
+    params_.materials = o.node_materials ? model_.materials_offset() : 0u;
 }
 
 void NeuralStage::update(const NeuralRenderOptions& o, vk::Buffer& params_buffer) {

@@ -60,6 +60,9 @@ struct NeuralRenderOptions {
     // Skip (ray, leaf) pairs whose segment crosses only empty cells of the leaf's occupancy mask
     // (shared/neural_occupancy.h; models without masks query every leaf). --neural-occupancy on|off.
     bool occupancy = true;
+    // Hits take the metallic/roughness of the N-BVH node that answered them (engine/neural/
+    // node_materials.h; models without them: the asset's). --neural-materials node|asset.
+    bool node_materials = true;
     // A ray leaving a neural hit seen from behind (predicted normal along the incoming ray) skips
     // back-facing neural hits, so that it leaves the asset instead of bouncing inside it
     // (NB_RAY_BACKFACE_BIT, engine/render/NEURAL.md). --neural-backface-escape on|off.

@@ -1,10 +1,11 @@
 // The shading surface of a neural hit: position on the ray, the predicted normal (world space, turned
 // towards the incoming ray, used as geometric and shading normal), the predicted albedo as base colour
 // (it learned factor x texture), and the rest from the asset's glTF material: metallic and roughness
-// as factor x the texture's mean over the asset (asset_table.h asset_shading: a neural hit has no uv),
-// transmission and emission factors, unless the user overrides metallic/roughness
-// (--neural-metallic, --neural-roughness). Included by passes/shade.comp after
-// lib/material.glsl.
+// as factor x the texture's mean over the triangles of the N-BVH node that answered the hit
+// (engine/neural/node_materials.h; a neural hit has no uv), or over the whole asset for models without
+// per-node materials or with --neural-materials asset (asset_table.h asset_shading), transmission and
+// emission factors, unless the user overrides metallic/roughness (--neural-metallic,
+// --neural-roughness). Included by passes/shade.comp after lib/material.glsl.
 #ifndef NB_NEURAL_SURFACE_GLSL
 #define NB_NEURAL_SURFACE_GLSL
 #include "lib/neural_bindings.glsl"
@@ -21,9 +22,11 @@ Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t) {
     if (dot(n, ray_dir) > 0.0f) n = -n;
     s.ng = n;
     s.n = n;
-    s.base = clamp(st.albedo, 0.0f, 1.0f);
-    float metallic = neural_params.metallic < 0.0f ? asset.metallic : neural_params.metallic;
-    float roughness = neural_params.roughness < 0.0f ? asset.roughness : neural_params.roughness;
+    s.base = clamp(vec3(unpackHalf2x16(st.albedo_rg), unpackHalf2x16(st.albedo_b).x), 0.0f, 1.0f);
+    vec2 mr = vec2(asset.metallic, asset.roughness);
+    if (neural_params.materials != 0u) mr = unpackUnorm2x16(nbvh_bounds_words[neural_params.materials + st.hit_leaf]);
+    float metallic = neural_params.metallic < 0.0f ? mr.x : neural_params.metallic;
+    float roughness = neural_params.roughness < 0.0f ? mr.y : neural_params.roughness;
     s.metallic = clamp(metallic, 0.0f, 1.0f);
     s.alpha = nb_ggx_alpha(clamp(roughness, 0.0f, 1.0f));
     bool from_material = neural_params.metallic < 0.0f && neural_params.roughness < 0.0f;

@@ -164,12 +164,14 @@ bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, inout GpuN
 }
 
 // A neural hit in front of the ray's best one becomes its best hit (pairs applied in key order, so the
-// first of equal hits wins, as with one leaf per round).
-void nb_nl_take_hit(inout GpuNeuralRayState st, float t, vec3 normal, vec3 albedo, uint instance) {
+// first of equal hits wins, as with one leaf per round); `leaf` is the N-BVH node that answered it.
+void nb_nl_take_hit(inout GpuNeuralRayState st, float t, vec3 normal, vec3 albedo, uint instance, uint leaf) {
     if (t < st.best_t) {
         st.best_t = t;
         st.normal = normal;
-        st.albedo = albedo;
+        st.albedo_rg = packHalf2x16(albedo.rg);
+        st.albedo_b = packHalf2x16(vec2(albedo.b, 0.0f));
+        st.hit_leaf = leaf;
         st.instance = instance;
     }
 }
@@ -186,7 +188,7 @@ bool nb_nl_is_pending(uint status) { return status == NB_NRAY_PENDING || status 
 void nb_nl_reduce_group(uint slot, uint group, inout GpuNeuralRayState st) {
     for (uint j = 0u; j < group; ++j) {
         GpuPendingLeaf pl = nb_pending_load(slot + j);
-        nb_nl_take_hit(st, pl.hit_t, pl.hit_normal, pl.hit_albedo, pl.instance);
+        nb_nl_take_hit(st, pl.hit_t, pl.hit_normal, pl.hit_albedo, pl.instance, pl.leaf);
     }
     st.status = NB_NRAY_TRACE;
 }
@@ -214,7 +216,9 @@ GpuNeuralRayState nb_nl_fresh_state() {
     GpuNeuralRayState st;
     st.normal = vec3(0.0f, 0.0f, 1.0f);
     st.best_t = NB_INF;
-    st.albedo = vec3(0.0f);
+    st.albedo_rg = 0u;
+    st.albedo_b = 0u;
+    st.hit_leaf = 0u;
     st.instance = NB_NO_HIT;
     st.key_t = -NB_INF;
     st.key_instance = 0u;

@@ -44,7 +44,7 @@ void main() {
         NbPendingQuery rj = j == 0u ? r : nb_load_pending(gl_GlobalInvocationID.x + j);
         vec3 n, a;
         float t = nb_tail_query(rj, n, a);
-        nb_nl_take_hit(st, t, n, a, rj.pl.instance);
+        nb_nl_take_hit(st, t, n, a, rj.pl.instance, rj.pl.leaf);
     }
     for (uint guard = 0u; guard <= neural_params.max_rounds; ++guard) {
         if (shadow && st.best_t < NB_INF) { // occluded
@@ -85,7 +85,7 @@ void main() {
         r.dir = nb_xform_vector(inst.world_to_object, dir);
         vec3 n, a;
         float t = nb_tail_query(r, n, a);
-        nb_nl_take_hit(st, t, n, a, r.pl.instance);
+        nb_nl_take_hit(st, t, n, a, r.pl.instance, r.pl.leaf);
     }
     neural_state[ray] = st;
 }

@@ -112,7 +112,9 @@ NB_FN void nb_neural_cull_bounds(NB_INOUT(vec3) lo, NB_INOUT(vec3) hi) {
 struct GpuNeuralRayState {
     vec3 normal;    // world-space unit normal of the best neural hit
     float best_t;   // NB_INF: none
-    vec3 albedo;
+    uint albedo_rg; // albedo of the best hit, fp16 (GLSL packHalf2x16)
+    uint albedo_b;  // ... blue, fp16 in the low half
+    uint hit_leaf;  // N-BVH node (model order) that answered the best hit: its material (GpuNeuralParams.materials)
     uint instance;  // neural instance of the best hit
     float key_t;    // key of the last queued leaf
     uint key_instance;
@@ -153,8 +155,22 @@ struct GpuNeuralParams {
     // Occupancy masks (shared/neural_occupancy.h): their first word in the node-bounds buffer
     // (NB_BIND_NBVH_BOUNDS seen as words, after the 6 words per node of the bounds), 0 = none or off.
     uint occupancy;
+    // Per-node materials (engine/neural/node_materials.h, nb_pack_node_material): their first word in
+    // the same buffer, one word per node; 0 = none or off (hits take their asset's metallic/roughness).
+    uint materials;
+    uint pad0;
+    uint pad1;
+    uint pad2;
 };
-NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 64, "GpuNeuralParams layout");
+NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 80, "GpuNeuralParams layout");
+
+// A node's metallic and roughness in one word: unorm16 each, metallic in the low half (GLSL
+// unpackUnorm2x16 reads it back as vec2(metallic, roughness)).
+NB_FN uint nb_pack_node_material(float metallic, float roughness) {
+    float m = metallic > 0.0f ? (metallic < 1.0f ? metallic : 1.0f) : 0.0f; // NaN -> 0
+    float r = roughness > 0.0f ? (roughness < 1.0f ? roughness : 1.0f) : 0.0f;
+    return uint(m * 65535.0f + 0.5f) | (uint(r * 65535.0f + 0.5f) << 16u);
+}
 
 struct GpuNeuralCounters {
     uint pending_active;  // pairs the current neural_query dispatch processes

@@ -101,11 +101,13 @@
 #define NB_LAYOUT_FIELDS_GpuNeuralEvalPush(F) \
     F(box.center) F(box.depth_pad) F(box.extent) F(box.fixed_depth_eps) F(count) F(threshold) F(pad0) F(pad1)
 #define NB_LAYOUT_FIELDS_GpuNeuralRayState(F)                                                     \
-    F(normal) F(best_t) F(albedo) F(instance) F(key_t) F(key_instance) F(key_leaf) F(status)      \
+    F(normal) F(best_t) F(albedo_rg) F(albedo_b) F(hit_leaf) F(instance) F(key_t) F(key_instance)    \
+    F(key_leaf) F(status)                                                                         \
     F(tri_t) F(tri_instance) F(tri_triangle) F(rounds)
 #define NB_LAYOUT_FIELDS_GpuNeuralParams(F)                                                       \
     F(box.center) F(box.depth_pad) F(box.extent) F(box.fixed_depth_eps) F(lod_primary)            \
-    F(lod_secondary) F(roughness) F(metallic) F(threshold) F(max_rounds) F(leaves_per_round) F(occupancy)
+    F(lod_secondary) F(roughness) F(metallic) F(threshold) F(max_rounds) F(leaves_per_round) F(occupancy) \
+    F(materials) F(pad0) F(pad1) F(pad2)
 #define NB_LAYOUT_FIELDS_GpuNeuralCounters(F) F(pending_active) F(queries_total) F(leaf_cap_rays) F(rounds) F(queries_total_hi) F(pad0) F(pad1) F(pad2)
 #define NB_LAYOUT_FIELDS_GpuNeuralAsset(F)                                                        \
     F(roots[0]) F(roots[1]) F(roots[2]) F(roots[3]) F(roots[4]) F(roots[5]) F(roots[6]) F(roots[7]) \

@@ -33,6 +33,7 @@ TEST(CliExplain, HybridRenderListsTheNeuralPasses) {
     EXPECT_TRUE(has(o, "at most 8, 2 queued per round: 4 batched rounds")) << o; // the defaults
     EXPECT_TRUE(has(o, "occupancy masks on")) << o;
     EXPECT_TRUE(has(o, "back-face escape on")) << o;
+    EXPECT_TRUE(has(o, "materials       per node")) << o;
     for (const char* pass :
          {"passes/neural_traverse.comp", "passes/neural_args.comp", "passes/neural_query_scalar.comp",
           "passes/neural_tail.comp", "passes/neural_shadow.comp", "passes/shade.comp"})
@@ -95,11 +96,14 @@ TEST(CliExplain, ForcedCoopmatOnLavapipeIsTheRendersError) {
 
 TEST(CliExplain, CullingSwitchesAreNamed) {
     const auto r = run_nbvh(explain({"--model", tiny_model().string(), "--neural-occupancy", "off",
-                                     "--neural-backface-escape", "off"}),
+                                     "--neural-backface-escape", "off", "--neural-materials", "asset"}),
                             60.0);
     ASSERT_EQ(r.exit_code, 0) << r.describe();
     EXPECT_TRUE(has(r.out, "occupancy masks off (--neural-occupancy off)")) << r.out;
     EXPECT_TRUE(has(r.out, "back-face escape off (--neural-backface-escape off)")) << r.out;
+    EXPECT_TRUE(has(r.out, "materials       per asset (--neural-materials asset)")) << r.out;
     const auto bad = run_nbvh(explain({"--model", tiny_model().string(), "--neural-backface-escape", "maybe"}), 60.0);
     EXPECT_EQ(check_clean_error(bad, {"--neural-backface-escape"}, false), "") << bad.describe();
+    const auto bad2 = run_nbvh(explain({"--model", tiny_model().string(), "--neural-materials", "leaf"}), 60.0);
+    EXPECT_EQ(check_clean_error(bad2, {"--neural-materials"}, false), "") << bad2.describe();
 }

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "engine/core/error.h"
+#include "shaders/shared/neural_gpu.h"
 #include "shaders/shared/neural_occupancy.h"
 #include "tests/model/tiny_model.h"
 #include "tests/support/test_support.h"
@@ -108,7 +109,7 @@ TEST(ModelFile, SaveIsAtomicAndLoadReadsItBack) {
 // Pins the format: any change to the byte layout must bump MODEL_FORMAT_VERSION and this test.
 TEST(ModelFile, GoldenBytes) {
     const std::vector<uint8_t> b = serialize_model(make_tiny_model());
-    const uint8_t head[16] = {'N', 'B', 'V', 'H', 3, 0, 0, 0, 8, 0, 0, 0, 0, 0, 0, 0};
+    const uint8_t head[16] = {'N', 'B', 'V', 'H', 4, 0, 0, 0, 8, 0, 0, 0, 0, 0, 0, 0};
     ASSERT_GE(b.size(), 16u);
     EXPECT_EQ(std::memcmp(b.data(), head, 16), 0);
     std::vector<std::string> ids;
@@ -123,7 +124,7 @@ TEST(ModelFile, GoldenBytes) {
     const uint32_t node_head[2 + 10] = {5, 0, 0, 0, 0, 0x3f800000u, 0x3f800000u, 0x3f800000u, 1, 0, 0xFFu, 0};
     EXPECT_EQ(std::memcmp(b.data() + section_offset(b, "NODE"), node_head, sizeof(node_head)), 0);
     EXPECT_EQ(b.size(), 40984u);
-    EXPECT_EQ(fnv1a64(b.data(), b.size()), 0xe6c026ba917b4388ull) << std::hex << fnv1a64(b.data(), b.size());
+    EXPECT_EQ(fnv1a64(b.data(), b.size()), 0x03f899d3fe60a69bull) << std::hex << fnv1a64(b.data(), b.size());
 }
 
 // Occupancy masks (version 3): an optional section after META, written only when the model has masks,
@@ -157,6 +158,41 @@ TEST(ModelFile, OccupancyMasksAreAnOptionalSection) {
     std::vector<uint8_t> c = b;
     for (size_t k = 0; k < ids.size(); ++k)
         if (ids[k] == "OCCU") poke<uint64_t>(c, 32 + 32 * k + 16, 8 + 5 * NB_OCC_WORDS * 4 - 8);
+    refresh_checksums(c);
+    EXPECT_THROW(parse_model(c, "m.nbvh"), Error);
+}
+
+// Node materials (version 4): an optional section after OCCU (when present), one word per node, read
+// back exactly; refused in an older version's file, with the wrong node count, a non-zero reserved
+// field or a short payload; counted in the model's GPU bytes.
+TEST(ModelFile, NodeMaterialsAreAnOptionalSection) {
+    NeuralModel a = make_tiny_model();
+    for (const auto& s : test::section_locations(serialize_model(a))) EXPECT_NE(s.id, "MATL");
+    const uint64_t plain_bytes = model_gpu_bytes(a);
+    a.occupancy.assign(a.nodes.size() * NB_OCC_WORDS, 0xFFFFFFFFu);
+    for (uint32_t i = 0; i < a.nodes.size(); ++i) a.node_materials.push_back(nb_pack_node_material(0.1f * i, 1.0f - 0.2f * i));
+    EXPECT_EQ(model_gpu_bytes(a) - plain_bytes, a.nodes.size() * (NB_OCC_WORDS + 1) * 4);
+    const std::vector<uint8_t> b = serialize_model(a);
+    std::vector<std::string> ids;
+    for (const auto& s : test::section_locations(b)) ids.push_back(s.id);
+    EXPECT_EQ(ids, (std::vector<std::string>{"CONF", "ASST", "LEVL", "LODS", "NODE", "MLP ", "GRID", "META", "OCCU", "MATL"}));
+    const uint32_t head[4] = {5, 0, a.node_materials[0], a.node_materials[1]};
+    EXPECT_EQ(std::memcmp(b.data() + section_offset(b, "MATL"), head, sizeof(head)), 0);
+    const NeuralModel back = parse_model(b);
+    EXPECT_EQ(back.node_materials, a.node_materials);
+    EXPECT_EQ(back.occupancy, a.occupancy);
+    auto edited = [&](size_t at, uint32_t value) {
+        std::vector<uint8_t> c = b;
+        poke(c, at, value);
+        refresh_checksums(c);
+        return c;
+    };
+    expect_rejected(edited(4, 3), "node materials need format version 4");
+    expect_rejected(edited(section_offset(b, "MATL"), 4), "4 nodes, the model has 5");
+    expect_rejected(edited(section_offset(b, "MATL") + 4, 1), "reserved field is not zero");
+    std::vector<uint8_t> c = b;
+    for (size_t k = 0; k < ids.size(); ++k)
+        if (ids[k] == "MATL") poke<uint64_t>(c, 32 + 32 * k + 16, 8 + 5 * 4 - 4);
     refresh_checksums(c);
     EXPECT_THROW(parse_model(c, "m.nbvh"), Error);
 }
@@ -207,9 +243,9 @@ TEST(ModelFile, ForeignFilesAreRejected) {
     expect_rejected(c, "not an nbvh model (bad magic)");
     expect_rejected({}, "not an nbvh model (file too short)");
     c = b;
-    poke<uint32_t>(c, 4, 4);
+    poke<uint32_t>(c, 4, 5);
     refresh_checksums(c);
-    expect_rejected(c, "unsupported model format version 4");
+    expect_rejected(c, "unsupported model format version 5");
     // An official N-BVH tree file (u64 N, u64 1, N x 40 bytes, u64 0) of 3 nodes.
     std::vector<uint8_t> official(16 + 3 * 40 + 8, 0);
     poke<uint64_t>(official, 0, 3);

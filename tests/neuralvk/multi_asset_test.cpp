@@ -282,6 +282,45 @@ TEST(MultiAsset, BackfaceEscapeIsOffForTransmissiveAssets) {
     }
 }
 
+// Per-node materials reach the shade pass through the leaf that answered the hit: every node of the
+// pillar's subtree made a rough metal (metallic 1, roughness 1: exact in unorm16), the others as built
+// (the scene has no textures: their words equal their asset's factors). Max depth 2 (camera hits and
+// their direct light), so a pixel depends on its own surface alone: the pillar's pixels match a render whose --neural-metallic 1
+// --neural-roughness 1 override every asset, the other nodes' match the per-asset render (only
+// silhouette pixels, mixed by the jittered samples, can differ). Control: the per-asset render's pillar.
+TEST(MultiAsset, NodeMaterialsShadeTheHitsOfTheirLeaves) {
+    const Trained& t = trained();
+    NeuralModel model = t.model;
+    ASSERT_EQ(model.node_materials.size(), model.nodes.size());
+    const uint32_t pillar = 3;
+    ASSERT_EQ(model.assets[pillar].name, "pillar");
+    std::vector<uint32_t> stack{model.assets[pillar].root};
+    while (!stack.empty()) {
+        const uint32_t i = stack.back();
+        stack.pop_back();
+        model.node_materials[i] = nb_pack_node_material(1.0f, 1.0f);
+        if (model.nodes[i].has_children()) stack.insert(stack.end(), {model.nodes[i].left, model.nodes[i].left + 1});
+    }
+    LiveSetup s(model, SIZE, 5);
+    s.options.max_depth = 2;
+    s.options.spp = 4;
+    const Image node = convert_channels(s.fresh(s.options), 3);
+    RenderOptions o = s.options;
+    o.neural.node_materials = false;
+    const Image asset = convert_channels(s.fresh(o), 3);
+    o.neural.metallic = o.neural.roughness = 1.0f;
+    const Image metal = convert_channels(s.fresh(o), 3);
+    const std::map<std::string, float> vs_metal = flip_per_node(s.scene, metal, node);
+    const std::map<std::string, float> vs_asset = flip_per_node(s.scene, asset, node);
+    const std::map<std::string, float> control = flip_per_node(s.scene, metal, asset);
+    for (const auto& [name, e] : vs_asset) {
+        const float err = name == "pillar" ? vs_metal.at(name) : e;
+        std::printf("node %-8s FLIP %.4f (control: metal vs asset %.4f)\n", name.c_str(), err, control.at(name));
+        EXPECT_LT(err, 0.02f) << name;
+    }
+    EXPECT_GT(control.at("pillar"), 0.1f);
+}
+
 TEST(MultiAsset, AModelForAnotherSceneIsRefusedNamingTheAsset) {
     const Trained& t = trained();
     auto expect_refused = [&](Scene s, const std::string& needle) {
