@@ -47,6 +47,26 @@ size_t section_offset(const std::vector<uint8_t>& b, const std::string& id) {
     return 0;
 }
 
+// `b` with the u32 at `at` replaced and the checksums made valid again.
+std::vector<uint8_t> edited(const std::vector<uint8_t>& b, size_t at, uint32_t value) {
+    std::vector<uint8_t> c = b;
+    poke(c, at, value);
+    refresh_checksums(c);
+    return c;
+}
+
+// `b` whose section table gives section `id` `size` bytes (checksums valid again).
+std::vector<uint8_t> resized_section(const std::vector<uint8_t>& b, const std::string& id, uint64_t size) {
+    std::vector<uint8_t> c = b;
+    size_t k = 0;
+    for (const auto& s : test::section_locations(b)) {
+        if (s.id == id) poke<uint64_t>(c, 32 + 32 * k + 16, size);
+        ++k;
+    }
+    refresh_checksums(c);
+    return c;
+}
+
 TEST(ModelFile, RoundTrip) {
     const NeuralModel a = make_tiny_model();
     const NeuralModel b = parse_model(serialize_model(a));
@@ -145,21 +165,11 @@ TEST(ModelFile, OccupancyMasksAreAnOptionalSection) {
     const uint32_t head[4] = {5, NB_OCC_WORDS, a.occupancy[0], a.occupancy[1]};
     EXPECT_EQ(std::memcmp(b.data() + section_offset(b, "OCCU"), head, sizeof(head)), 0);
     EXPECT_EQ(parse_model(b).occupancy, a.occupancy);
-    auto edited = [&](size_t at, uint32_t value) {
-        std::vector<uint8_t> c = b;
-        poke(c, at, value);
-        refresh_checksums(c);
-        return c;
-    };
-    expect_rejected(edited(4, 2), "occupancy masks need format version 3");
-    expect_rejected(edited(section_offset(b, "OCCU"), 4), "4 nodes x 16 words, the model has 5 nodes");
-    expect_rejected(edited(section_offset(b, "OCCU") + 4, 64), "5 nodes x 64 words, the model has 5 nodes x 16");
+    expect_rejected(edited(b, 4, 2), "occupancy masks need format version 3");
+    expect_rejected(edited(b, section_offset(b, "OCCU"), 4), "4 nodes x 16 words, the model has 5 nodes");
+    expect_rejected(edited(b, section_offset(b, "OCCU") + 4, 64), "5 nodes x 64 words, the model has 5 nodes x 16");
     // A shorter payload (the section table says 8 bytes less).
-    std::vector<uint8_t> c = b;
-    for (size_t k = 0; k < ids.size(); ++k)
-        if (ids[k] == "OCCU") poke<uint64_t>(c, 32 + 32 * k + 16, 8 + 5 * NB_OCC_WORDS * 4 - 8);
-    refresh_checksums(c);
-    EXPECT_THROW(parse_model(c, "m.nbvh"), Error);
+    EXPECT_THROW(parse_model(resized_section(b, "OCCU", 8 + 5 * NB_OCC_WORDS * 4 - 8), "m.nbvh"), Error);
 }
 
 // Node materials (version 4): an optional section after OCCU (when present), one word per node, read
@@ -181,20 +191,10 @@ TEST(ModelFile, NodeMaterialsAreAnOptionalSection) {
     const NeuralModel back = parse_model(b);
     EXPECT_EQ(back.node_materials, a.node_materials);
     EXPECT_EQ(back.occupancy, a.occupancy);
-    auto edited = [&](size_t at, uint32_t value) {
-        std::vector<uint8_t> c = b;
-        poke(c, at, value);
-        refresh_checksums(c);
-        return c;
-    };
-    expect_rejected(edited(4, 3), "node materials need format version 4");
-    expect_rejected(edited(section_offset(b, "MATL"), 4), "4 nodes, the model has 5");
-    expect_rejected(edited(section_offset(b, "MATL") + 4, 1), "reserved field is not zero");
-    std::vector<uint8_t> c = b;
-    for (size_t k = 0; k < ids.size(); ++k)
-        if (ids[k] == "MATL") poke<uint64_t>(c, 32 + 32 * k + 16, 8 + 5 * 4 - 4);
-    refresh_checksums(c);
-    EXPECT_THROW(parse_model(c, "m.nbvh"), Error);
+    expect_rejected(edited(b, 4, 3), "node materials need format version 4");
+    expect_rejected(edited(b, section_offset(b, "MATL"), 4), "4 nodes, the model has 5");
+    expect_rejected(edited(b, section_offset(b, "MATL") + 4, 1), "reserved field is not zero");
+    EXPECT_THROW(parse_model(resized_section(b, "MATL", 8 + 5 * 4 - 4), "m.nbvh"), Error);
 }
 
 TEST(ModelFile, TruncationAnywhereIsRejected) {
