@@ -12,12 +12,13 @@
 #      training settings; OLD may then be the same binary as NEW).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
+source scripts/bench/lib.sh
 OLD=$1 NEW=$2 OUT=$3
 DRAGON=${DRAGON:-.device/study/dragon/dragon_vrip.glb.xz}
 SPP=${SPP:-16}
 T=${TMPDIR:-/tmp}/nbvh_ab
 mkdir -p "$OUT" "$T"
-python3 -c 'import lzma, shutil, sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2], "wb"))' "$DRAGON" "$T/dragon.glb"
+unpack "$DRAGON" "$T/dragon.glb"
 (nvidia-smi --query-gpu=name,driver_version --format=csv,noheader || echo "no nvidia-smi") | tee "$OUT/device.txt"
 # shellcheck disable=SC2206
 R=(--width "${WIDTH:-1920}" --height "${HEIGHT:-1080}" --max-depth 8 --exposure 0 ${RENDER_ARGS:-})

@@ -23,10 +23,10 @@ SPP=${SPP:-1024} REF_SPP=${REF_SPP:-4096}
 CAM="0.600,0.358,0.179,-0.197,-0.197,-0.057,45"
 mkdir -p "$OUT"
 MODEL=${MODEL:-$OUT/chess.nbvh}
-if [[ $SCENE == *.xz ]]; then # xz, else Python's lzma (as scripts/bench/study.sh)
+if [[ $SCENE == *.xz ]]; then
+  source "$(dirname "$0")/lib.sh"
   U="${TMPDIR:-/tmp}/$(basename "${SCENE%.xz}")"
-  if command -v xz >/dev/null; then xz -dc "$SCENE" > "$U"
-  else python3 -c 'import lzma, shutil, sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2], "wb"))' "$SCENE" "$U"; fi
+  unpack "$SCENE" "$U"
   SCENE=$U
 fi
 S="$OUT/summary.txt"

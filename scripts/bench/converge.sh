@@ -21,10 +21,7 @@ NBVH=${NBVH:-.device/study/bin/nbvh}
 mkdir -p "$OUT"
 TMP=${TMPDIR:-/tmp}/nbvh_converge
 mkdir -p "$TMP"
-unpack() { # SRC.xz DST: xz, else Python's lzma
-  if command -v xz >/dev/null; then xz -dc "$1" > "$2"
-  else python3 -c 'import lzma, shutil, sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2], "wb"))' "$1" "$2"; fi
-}
+source scripts/bench/lib.sh
 if [ ! -x "$NBVH" ] && [ -f "$NBVH.xz" ]; then
   unpack "$NBVH.xz" "$TMP/nbvh" && chmod +x "$TMP/nbvh" && NBVH=$TMP/nbvh
 fi

@@ -8,7 +8,8 @@
 # .device/study/bin/nbvh; carry .gl .device/env.sh .device/lib .device/study/bin .device/study/dragon)
 set -euo pipefail
 B=${NBVH:-.device/study/bin/nbvh}; OUT=$1; T=/tmp/defaults; mkdir -p $T $OUT
-python3 -c 'import lzma, shutil, sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2], "wb"))' .device/study/dragon/dragon_vrip.glb.xz $T/dragon.glb
+source "$(dirname "$0")/lib.sh"
+unpack .device/study/dragon/dragon_vrip.glb.xz $T/dragon.glb
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | tee $OUT/device.txt
 for scene in default dragon; do
   if [ $scene = default ]; then S=(default); N=(); else S=($T/dragon.glb); N=(--neural '*'); fi

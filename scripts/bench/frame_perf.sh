@@ -15,6 +15,7 @@
 #      TRAIN_ARGS="--backend cpu --steps 20 --batch 256 --nodes 63" NBVH=build/app/nbvh scripts/bench/frame_perf.sh OUT
 set -euo pipefail
 cd "$(dirname "$0")/../.."
+source scripts/bench/lib.sh
 OUT=$1
 NBVH=${NBVH:-.device/study/bin/nbvh}
 DRAGON=${DRAGON:-.device/study/dragon/dragon_vrip.glb.xz}
@@ -42,7 +43,7 @@ row default_hybrid default --model "$T/default.nbvh"
 row default_hybrid_secondary_same default --model "$T/default.nbvh" --secondary-lod same
 row default_hybrid_lods1 default --model "$T/default_lods1.nbvh"
 if [ -z "${NO_DRAGON:-}" ]; then
-  python3 -c 'import lzma, shutil, sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2], "wb"))' "$DRAGON" "$T/dragon.glb"
+  unpack "$DRAGON" "$T/dragon.glb"
   train "$T/dragon.nbvh" "$OUT/train_dragon.log" "$T/dragon.glb" --neural '*'
   train "$T/dragon_lods1.nbvh" "$OUT/train_dragon_lods1.log" "$T/dragon.glb" --neural '*' --lods 1
   row dragon_classical "$T/dragon.glb" --neural '*' --classical

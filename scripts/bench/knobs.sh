@@ -2,7 +2,8 @@
 # GPU machine (results/perf/knobs_h200.txt, issue 14): one binary, hybrid leaves-per-round x wave paths, classical wave paths; 1080p 16 spp, interleaved reps
 set -euo pipefail
 B=${NBVH:-.device/study/bin/nbvh}; OUT=$1; T=/tmp/knobs; mkdir -p $T $OUT
-python3 -c 'import lzma, shutil, sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2], "wb"))' .device/study/dragon/dragon_vrip.glb.xz $T/dragon.glb
+source "$(dirname "$0")/lib.sh"
+unpack .device/study/dragon/dragon_vrip.glb.xz $T/dragon.glb
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | tee $OUT/device.txt
 $B train default --out $T/default.nbvh > $OUT/train_default.log 2>&1
 $B train $T/dragon.glb --neural '*' --out $T/dragon.nbvh > $OUT/train_dragon.log 2>&1

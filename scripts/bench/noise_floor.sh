@@ -11,11 +11,11 @@ set -uo pipefail
 cd "$(dirname "$0")/../.."
 OUT=$1
 mkdir -p "$OUT"
-unxz_to() { python3 -c 'import lzma, shutil, sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2], "wb"))' "$1" "$2"; }
+source scripts/bench/lib.sh
 B=/tmp/nbvh_floor
-unxz_to "${NBVH:-.device/study/bin/nbvh.xz}" $B && chmod +x $B
+unpack "${NBVH:-.device/study/bin/nbvh.xz}" $B && chmod +x $B
 CHESS=${CHESS:-.device/study/chess}
-unxz_to "$CHESS/abeautifulgame.glb.xz" /tmp/chess.glb
+unpack "$CHESS/abeautifulgame.glb.xz" /tmp/chess.glb
 {
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
 W=(--width 960 --height 540 --max-depth 8)

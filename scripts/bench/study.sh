@@ -17,10 +17,7 @@ NBVH=${NBVH:-.device/study/bin/nbvh}
 mkdir -p "$OUT"
 TMP=${TMPDIR:-/tmp}/nbvh_study
 mkdir -p "$TMP"
-unpack() { # SRC.xz DST: xz, else Python's lzma (both are on the GPU machine's Ubuntu; one is enough)
-  if command -v xz >/dev/null; then xz -dc "$1" > "$2"
-  else python3 -c 'import lzma, shutil, sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2], "wb"))' "$1" "$2"; fi
-}
+source scripts/bench/lib.sh
 if [ ! -x "$NBVH" ] && [ -f "$NBVH.xz" ]; then # a carried, xz-packed binary
   unpack "$NBVH.xz" "$TMP/nbvh" && chmod +x "$TMP/nbvh" && NBVH=$TMP/nbvh
 fi
