@@ -4,6 +4,8 @@
 #include <cstring>
 
 #include "engine/neural/level_table.h"
+#include "shaders/shared/neural_gpu.h"
+#include "shaders/shared/neural_occupancy.h"
 #include "tests/model/tiny_model.h"
 
 namespace nbvh::fuzz {
@@ -37,6 +39,13 @@ NeuralModel with_tree(NeuralModel m, uint32_t depth, uint32_t lods, uint32_t rou
     return m;
 }
 
+// The tiny model with its optional sections: occupancy masks (OCCU) and node materials (MATL).
+NeuralModel with_masks_and_materials(NeuralModel m) {
+    m.occupancy.assign(m.nodes.size() * NB_OCC_WORDS, 0x0F0F0F0Fu);
+    for (uint32_t i = 0; i < m.nodes.size(); ++i) m.node_materials.push_back(nb_pack_node_material(0.2f * i, 1.0f - 0.1f * i));
+    return m;
+}
+
 } // namespace
 
 std::vector<Seed> model_seeds() {
@@ -63,6 +72,7 @@ std::vector<Seed> model_seeds() {
     out.push_back({"valid_one_lod.nbvh", bytes_of(with_tree(tiny, 3, 1, 2))});
     out.push_back({"valid_four_lods.nbvh", bytes_of(with_tree(tiny, 5, 4, 4))});
     out.push_back({"valid_root_only.nbvh", bytes_of(with_tree(tiny, 2, 1, 0))});
+    out.push_back({"valid_masks_materials.nbvh", bytes_of(with_masks_and_materials(tiny))});
 
     // Damaged copies of the tiny model.
     auto cut = [&](size_t n) { return std::vector<uint8_t>(tiny_bytes.begin(), tiny_bytes.begin() + long(n)); };

@@ -14,7 +14,7 @@ struct Seed {
 };
 
 // A handful of valid models (tests/model/tiny_model.h and variations of it: several assets, another hash
-// size, one and four LoDs, a root-only tree), truncated and bit-flipped copies of the tiny model (flips with
+// size, one and four LoDs, a root-only tree, occupancy masks and node materials), truncated and bit-flipped copies of the tiny model (flips with
 // the checksums recomputed, so they reach the section decoders), and an official-format tree file.
 std::vector<Seed> model_seeds();
 

@@ -13,6 +13,8 @@
 
 #include "engine/core/error.h"
 #include "engine/neural/model_file.h"
+#include "shaders/shared/neural_gpu.h"
+#include "shaders/shared/neural_occupancy.h"
 #include "tests/model/tiny_model.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -87,6 +89,10 @@ int main(int argc, char** argv) {
     }
     const int iterations = argc > 1 ? std::atoi(argv[1]) : 3000;
     const std::vector<uint8_t> model = nbvh::serialize_model(nbvh::test::make_tiny_model());
+    nbvh::NeuralModel rich = nbvh::test::make_tiny_model(); // with the optional sections OCCU and MATL
+    rich.occupancy.assign(rich.nodes.size() * NB_OCC_WORDS, 0x0F0F0F0Fu);
+    rich.node_materials.assign(rich.nodes.size(), nb_pack_node_material(0.5f, 0.25f));
+    const std::vector<uint8_t> rich_bytes = nbvh::serialize_model(rich);
     std::vector<uint8_t> official(16 + 3 * 40 + 8, 0);
     const uint64_t three = 3, one = 1, left = 1, none = 0xFFFFFFFFull, leaf_code = 2;
     std::memcpy(official.data(), &three, 8);
@@ -99,7 +105,7 @@ int main(int argc, char** argv) {
     std::mt19937 rng(20240516);
     int accepted = 0;
     for (int i = 0; i < iterations; ++i) {
-        const std::vector<uint8_t> m = mutate((i % 5 == 4) ? official : model, rng);
+        const std::vector<uint8_t> m = mutate((i % 5 == 4) ? official : (i % 5 == 3) ? rich_bytes : model, rng);
         LLVMFuzzerTestOneInput(m.data(), m.size());
         try {
             (void)nbvh::parse_model(m, "count");
@@ -109,6 +115,7 @@ int main(int argc, char** argv) {
     }
     // The unmutated inputs must load (else the run proves nothing).
     (void)nbvh::parse_model(model, "seed");
+    (void)nbvh::parse_model(rich_bytes, "seed");
     (void)nbvh::import_official_tree(official, "seed");
     std::printf("fuzz_model_reader: %d mutants, %d accepted (all others rejected with nbvh::Error)\n", iterations,
                 accepted);
