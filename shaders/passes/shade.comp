@@ -46,8 +46,6 @@ void main() {
     Surface s = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE) ? nb_make_neural_surface(i, org, dir, t)
                                                                    : nb_make_surface(instance, tri_index, hit_load_bary(i), org, dir, t);
     vec3 wo = -dir;
-    // Rays leaving a neural hit seen from behind skip back-facing neural hits (NB_RAY_BACKFACE_BIT).
-    uint escape = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE && nb_neural_escapes(i, dir)) ? NB_RAY_BACKFACE_BIT : 0u;
 
     if (NB_HAS_EMISSION && dot(s.emission, s.emission) > 0.0f) {
         float w = 1.0f;
@@ -59,6 +57,8 @@ void main() {
         sample_radiance[slot] += throughput * s.emission * w;
     }
     if (depth + 1u >= params.max_depth) return; // the next segment would exceed --max-depth
+    // Rays leaving a neural hit seen from behind skip back-facing neural hits (NB_RAY_BACKFACE_BIT).
+    uint escape = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE && nb_neural_escapes(i, dir)) ? NB_RAY_BACKFACE_BIT : 0u;
 
     // Next-event estimation.
     if (NB_HAS_ENVIRONMENT || NB_HAS_EMISSION || NB_HAS_PUNCTUAL) {
