@@ -73,7 +73,9 @@ nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o
                        {"leaves_per_round", n.leaves_per_round},
                        {"batched_rounds", n.batched_rounds},
                        {"occupancy", n.occupancy},
-                       {"node_materials", n.node_materials},
+                       {"materials", n.materials == render::NeuralMaterials::fit    ? "fit"
+                                     : n.materials == render::NeuralMaterials::node ? "node"
+                                                                                     : "asset"},
                        {"backface_escape", n.backface_escape},
                        {"roughness_override", n.roughness},
                        {"metallic_override", n.metallic}};

@@ -5,6 +5,7 @@
 
 #include "engine/core/error.h"
 #include "shaders/shared/intersect.h"
+#include "engine/neural/asset_table.h"
 #include "engine/scene/texture_sampler.h"
 
 namespace nbvh {
@@ -88,14 +89,7 @@ GroundTruth trace_ground_truth(const TrainingAsset& asset, const glm::vec3& orig
         has_uv = true;
     }
     gt.normal = shading_normal(asset, tri, u, v, uv, has_uv);
-    glm::vec3 albedo(0.9f); // official default material base colour when none is given (notes §6.7)
-    if (material) {
-        albedo = glm::vec3(material->base_color);
-        if (has_uv && material->base_color_tex.texture >= 0)
-            albedo *= glm::vec3(sample_texture_ref(scene.textures, material->base_color_tex, uv, true, glm::vec4(1.0f)));
-    }
-    gt.albedo = glm::clamp(albedo, glm::vec3(0.0f), glm::vec3(1.0f));
-    if (!std::isfinite(gt.albedo.x + gt.albedo.y + gt.albedo.z)) gt.albedo = glm::vec3(0.9f);
+    gt.albedo = learned_albedo(scene, material, uv, has_uv);
     return gt;
 }
 

@@ -40,7 +40,11 @@ NeuralModel make_neural_model(const TrainingAsset& asset, const TrainResult& res
                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count(),
                  100.0 * occupancy_fraction(m.tree(), m.occupancy, 0), m.occupancy.size() * 4 / 1024);
     }
-    if (asset.mesh && asset.scene) m.node_materials = build_node_materials(m.nodes, asset.bvh(), *asset.mesh, *asset.scene);
+    if (asset.mesh && asset.scene) {
+        NodeMaterialTables t = build_node_materials(m.nodes, asset.bvh(), *asset.mesh, *asset.scene);
+        m.node_materials = std::move(t.means);
+        m.material_fits = std::move(t.fits);
+    }
     TrainingMetadata& meta = m.meta;
     meta.steps = result.log.size();
     meta.final_loss = result.log.empty() ? 0.0f : float(result.log.back().loss.total);

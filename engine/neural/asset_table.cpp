@@ -115,30 +115,48 @@ uint64_t material_fingerprint(const Scene& scene, uint32_t material) {
     return h == 0 ? 1 : h; // 0 means "unknown"
 }
 
-MaterialSums triangle_texture_sums(const Scene& scene, const Mesh& m, const Material& material, uint32_t t) {
-    MaterialSums out;
-    if (3 * size_t(t) + 2 >= m.indices.size()) return out;
+glm::vec3 learned_albedo(const Scene& scene, const Material* material, glm::vec2 uv, bool has_uv) {
+    glm::vec3 albedo(0.9f);
+    if (material) {
+        albedo = glm::vec3(material->base_color);
+        if (has_uv && material->base_color_tex.texture >= 0)
+            albedo *= glm::vec3(sample_texture_ref(scene.textures, material->base_color_tex, uv, true, glm::vec4(1.0f)));
+    }
+    albedo = glm::clamp(albedo, glm::vec3(0.0f), glm::vec3(1.0f));
+    return std::isfinite(albedo.x + albedo.y + albedo.z) ? albedo : glm::vec3(0.9f);
+}
+
+double triangle_material_points(const Scene& scene, const Mesh& m, const Material& material, uint32_t t,
+                                MaterialPoint points[MATERIAL_POINTS]) {
+    if (3 * size_t(t) + 2 >= m.indices.size()) return 0.0;
     const uint32_t* idx = &m.indices[3 * size_t(t)];
-    if (idx[0] >= m.positions.size() || idx[1] >= m.positions.size() || idx[2] >= m.positions.size()) return out;
+    if (idx[0] >= m.positions.size() || idx[1] >= m.positions.size() || idx[2] >= m.positions.size()) return 0.0;
     const glm::vec3 p0 = m.positions[idx[0]], p1 = m.positions[idx[1]], p2 = m.positions[idx[2]];
     const double area = 0.5 * double(glm::length(glm::cross(p1 - p0, p2 - p0)));
-    if (!(area > 0.0) || !std::isfinite(area)) return out;
-    out.area = area;
-    const TextureRef& ref = material.metallic_roughness_tex;
-    const std::vector<glm::vec2>& uvs = ref.uv_set == 1u ? m.uv1 : m.uv0;
-    if (ref.texture < 0 || size_t(ref.texture) >= scene.textures.size() || uvs.size() != m.positions.size()) {
-        out.metallic = out.roughness = area;
-        return out;
+    if (!(area > 0.0) || !std::isfinite(area)) return 0.0;
+    static constexpr float BARY[MATERIAL_POINTS][3] = {{1.f / 3, 1.f / 3, 1.f / 3}, {2.f / 3, 1.f / 6, 1.f / 6},
+                                                       {1.f / 6, 2.f / 3, 1.f / 6}, {1.f / 6, 1.f / 6, 2.f / 3}};
+    auto uv_of = [&](uint32_t uv_set, const float* w, glm::vec2& uv) {
+        const std::vector<glm::vec2>& uvs = uv_set == 1u ? m.uv1 : m.uv0;
+        if (uvs.size() != m.positions.size()) return false;
+        uv = w[0] * uvs[idx[0]] + w[1] * uvs[idx[1]] + w[2] * uvs[idx[2]];
+        return true;
+    };
+    const TextureRef& mr = material.metallic_roughness_tex;
+    const bool mr_texture = mr.texture >= 0 && size_t(mr.texture) < scene.textures.size();
+    for (uint32_t k = 0; k < MATERIAL_POINTS; ++k) {
+        MaterialPoint& p = points[k];
+        glm::vec2 uv(0.0f);
+        const bool has_uv = uv_of(material.base_color_tex.uv_set, BARY[k], uv);
+        p.albedo = learned_albedo(scene, &material, uv, has_uv);
+        p.metallic = p.roughness = 1.0f;
+        if (mr_texture && uv_of(mr.uv_set, BARY[k], uv)) {
+            const glm::vec4 c = sample_texture_ref(scene.textures, mr, uv, false, glm::vec4(1.0f));
+            p.metallic = c.b;
+            p.roughness = c.g;
+        }
     }
-    static constexpr float POINTS[4][3] = {{1.f / 3, 1.f / 3, 1.f / 3}, {2.f / 3, 1.f / 6, 1.f / 6},
-                                           {1.f / 6, 2.f / 3, 1.f / 6}, {1.f / 6, 1.f / 6, 2.f / 3}};
-    for (const auto& w : POINTS) {
-        const glm::vec2 uv = w[0] * uvs[idx[0]] + w[1] * uvs[idx[1]] + w[2] * uvs[idx[2]];
-        const glm::vec4 c = sample_texture_ref(scene.textures, ref, uv, false, glm::vec4(1.0f));
-        out.metallic += area * 0.25 * double(c.b);
-        out.roughness += area * 0.25 * double(c.g);
-    }
-    return out;
+    return area;
 }
 
 AssetShading asset_shading(const Scene& scene, uint32_t mesh) {
@@ -154,16 +172,20 @@ AssetShading asset_shading(const Scene& scene, uint32_t mesh) {
     const TextureRef& ref = material.metallic_roughness_tex;
     const std::vector<glm::vec2>& uvs = ref.uv_set == 1u ? m.uv1 : m.uv0;
     if (ref.texture < 0 || size_t(ref.texture) >= scene.textures.size() || uvs.size() != m.positions.size()) return s;
-    MaterialSums sum;
+    double area = 0.0, metallic = 0.0, roughness = 0.0;
+    MaterialPoint points[MATERIAL_POINTS];
     for (uint32_t t = 0; t < m.triangle_count(); ++t) {
-        const MaterialSums x = triangle_texture_sums(scene, m, material, t);
-        sum.area += x.area;
-        sum.metallic += x.metallic;
-        sum.roughness += x.roughness;
+        const double a = triangle_material_points(scene, m, material, t, points);
+        if (a <= 0.0) continue;
+        area += a;
+        for (const MaterialPoint& p : points) {
+            metallic += a / MATERIAL_POINTS * p.metallic;
+            roughness += a / MATERIAL_POINTS * p.roughness;
+        }
     }
-    if (sum.area > 0.0) {
-        s.metallic = std::clamp(float(double(s.metallic) * sum.metallic / sum.area), 0.0f, 1.0f);
-        s.roughness = std::clamp(float(double(s.roughness) * sum.roughness / sum.area), 0.0f, 1.0f);
+    if (area > 0.0) {
+        s.metallic = std::clamp(float(double(s.metallic) * metallic / area), 0.0f, 1.0f);
+        s.roughness = std::clamp(float(double(s.roughness) * roughness / area), 0.0f, 1.0f);
     }
     return s;
 }

@@ -40,13 +40,22 @@ struct AssetShading {
 };
 AssetShading asset_shading(const Scene& scene, uint32_t mesh);
 
-// Area-weighted sums of one triangle of `mesh` (triangle index `t`): its area and area x the
-// metallic-roughness texture's blue (metallic) and green (roughness) channels, averaged at 4 points
-// (1 without a texture). All zero for a degenerate triangle or out-of-range indices.
-struct MaterialSums {
-    double area = 0.0, metallic = 0.0, roughness = 0.0;
+// The albedo a network learns at a surface point (trainer/ground_truth.cpp): linear base colour, factor x
+// texture (sRGB decoded) at `uv` when `has_uv`, clamped to [0, 1]; 0.9 without a material (official
+// default, notes §6.7) or when not finite.
+glm::vec3 learned_albedo(const Scene& scene, const Material* material, glm::vec2 uv, bool has_uv);
+
+// One triangle of `mesh` (index `t`) seen at 4 fixed points (barycentric (1/3,1/3,1/3) and the three
+// (2/3,1/6,1/6) permutations): the learned albedo and the metallic-roughness texture's blue (metallic)
+// and green (roughness) channels, 1 without a texture (the factors are not applied). Returns the
+// triangle's area: 0, and `points` untouched, for a degenerate triangle or out-of-range indices.
+struct MaterialPoint {
+    glm::vec3 albedo{0.0f};
+    float metallic = 1.0f, roughness = 1.0f;
 };
-MaterialSums triangle_texture_sums(const Scene& scene, const Mesh& mesh, const Material& material, uint32_t t);
+inline constexpr uint32_t MATERIAL_POINTS = 4;
+double triangle_material_points(const Scene& scene, const Mesh& mesh, const Material& material, uint32_t t,
+                                MaterialPoint points[MATERIAL_POINTS]);
 
 // Binds a model to a scene: the model's assets decide which instances are neural (every instance of a
 // glTF mesh the model has an asset for), meshes are split by material, and every neural mesh must

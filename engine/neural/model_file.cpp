@@ -186,7 +186,8 @@ NeuralModel load_model(const std::filesystem::path& path) {
 uint64_t model_gpu_bytes(const NeuralModel& m) {
     const uint64_t interior = m.lod_node_counts.empty() ? 1 : (uint64_t(m.lod_node_counts[0]) / 2 + 1);
     return interior * sizeof(GpuBvhNode) + m.mlp.size() * 2 + m.grid.size() * 2 +
-           m.levels.size() * sizeof(GpuHashLevel) + m.occupancy.size() * 4 + m.node_materials.size() * 4;
+           m.levels.size() * sizeof(GpuHashLevel) + m.occupancy.size() * 4 + m.node_materials.size() * 4 +
+           m.material_fits.size() * 4;
 }
 
 // ---- the official tree file (notes §10) ----

@@ -19,7 +19,7 @@
 
 namespace nbvh {
 
-inline constexpr uint32_t MODEL_FORMAT_VERSION = 4; // written; versions 1 (one unnamed asset), 2 (no OCCU) and 3 (no MATL) still read
+inline constexpr uint32_t MODEL_FORMAT_VERSION = 5; // written; versions 1 (one unnamed asset), 2 (no OCCU), 3 (no MATL) and 4 (no MFIT) still read
 inline constexpr uint32_t MODEL_MAX_ASSETS = 65536;
 inline constexpr size_t MODEL_MAX_STRING = 4096; // bytes of a name in the file
 
@@ -71,6 +71,9 @@ struct NeuralModel {
     // Per-node metallic and roughness (engine/neural/node_materials.h): one word per node, or empty
     // (files before version 4, or models built without the triangles): hits take their asset's.
     std::vector<uint32_t> node_materials;
+    // Per-node metallic and roughness as linear functions of the predicted albedo (node_materials.h):
+    // NB_NODE_FIT_WORDS per node, or empty (files before version 5, or models built without the triangles).
+    std::vector<uint32_t> material_fits;
     TrainingMetadata meta;
     uint32_t file_version = 0;           // format version of the file it was read from (0: not read)
 

@@ -7,6 +7,7 @@
 #include "engine/core/log.h"
 #include "engine/neural/level_table.h"
 #include "shaders/shared/mlp.h"
+#include "shaders/shared/neural_gpu.h"
 #include "shaders/shared/neural_occupancy.h"
 
 namespace nbvh::model_io {
@@ -23,7 +24,8 @@ constexpr char ID_GRID[4] = {'G', 'R', 'I', 'D'};
 constexpr char ID_META[4] = {'M', 'E', 'T', 'A'};
 constexpr char ID_OCC[4] = {'O', 'C', 'C', 'U'}; // optional, version 3
 constexpr char ID_MATL[4] = {'M', 'A', 'T', 'L'}; // optional, version 4
-constexpr const char* ALL_IDS[] = {ID_CONF, ID_ASSET, ID_LEVELS, ID_LODS, ID_NODES, ID_MLP, ID_GRID, ID_META, ID_OCC, ID_MATL};
+constexpr char ID_MFIT[4] = {'M', 'F', 'I', 'T'}; // optional, version 5
+constexpr const char* ALL_IDS[] = {ID_CONF, ID_ASSET, ID_LEVELS, ID_LODS, ID_NODES, ID_MLP, ID_GRID, ID_META, ID_OCC, ID_MATL, ID_MFIT};
 
 constexpr uint8_t NODE_FLAG_FINAL = 1;
 
@@ -223,14 +225,17 @@ std::vector<Section> encode_sections(const NeuralModel& m) {
         w.str(t.source);
         out.push_back(make(ID_META, std::move(b)));
     }
-    if (!m.occupancy.empty()) {
+    // Optional per-node tables: node count, words per node, the words.
+    auto node_words = [&](const char id[4], const std::vector<uint32_t>& words, uint32_t per_node) {
+        if (words.empty()) return;
         b.clear();
         Writer w(b);
         w.u32(uint32_t(m.nodes.size()));
-        w.u32(NB_OCC_WORDS);
-        for (uint32_t v : m.occupancy) w.u32(v);
-        out.push_back(make(ID_OCC, std::move(b)));
-    }
+        w.u32(per_node);
+        for (uint32_t v : words) w.u32(v);
+        out.push_back(make(id, std::move(b)));
+    };
+    node_words(ID_OCC, m.occupancy, NB_OCC_WORDS);
     if (!m.node_materials.empty()) {
         b.clear();
         Writer w(b);
@@ -239,6 +244,7 @@ std::vector<Section> encode_sections(const NeuralModel& m) {
         for (uint32_t v : m.node_materials) w.u32(v);
         out.push_back(make(ID_MATL, std::move(b)));
     }
+    node_words(ID_MFIT, m.material_fits, NB_NODE_FIT_WORDS);
     return out;
 }
 
@@ -446,20 +452,30 @@ NeuralModel decode_sections(const std::vector<SectionView>& sections, const std:
             !std::isfinite(t.split_scaling) || !std::isfinite(t.split_interval_scaling))
             throw Error(r.where() + ": training metadata holds a non-finite or negative number");
     }
-    for (const SectionView& s : sections) {
-        if (std::memcmp(s.id, ID_OCC, 4) != 0) continue;
-        Reader r(s.bytes, name + ": section 'OCCU'");
-        if (version < 3) throw Error(r.where() + ": occupancy masks need format version 3");
-        const uint32_t count = r.u32(), words = r.u32();
-        if (count != m.nodes.size() || words != NB_OCC_WORDS)
-            throw Error(strfmt("%s: %u nodes x %u words, the model has %zu nodes x %u", r.where().c_str(), count, words,
-                               m.nodes.size(), NB_OCC_WORDS));
-        if (r.remaining() != size_t(count) * words * 4)
-            throw Error(r.where() + ": size does not match its node count");
-        m.occupancy.resize(size_t(count) * words);
-        for (uint32_t& v : m.occupancy) v = r.u32();
-        expect_end(r);
-    }
+    // Optional per-node tables (node count, words per node, the words); `valid` checks each word.
+    auto node_words = [&](const char id[4], uint32_t since, const char* what, uint32_t per_node,
+                          std::vector<uint32_t>& out, bool (*valid)(uint32_t)) {
+        for (const SectionView& s : sections) {
+            if (std::memcmp(s.id, id, 4) != 0) continue;
+            Reader r(s.bytes, name + ": section '" + id_string(id) + "'");
+            if (version < since) throw Error(strfmt("%s: %s need format version %u", r.where().c_str(), what, since));
+            const uint32_t count = r.u32(), words = r.u32();
+            if (count != m.nodes.size() || words != per_node)
+                throw Error(strfmt("%s: %u nodes x %u words, the model has %zu nodes x %u", r.where().c_str(), count,
+                                   words, m.nodes.size(), per_node));
+            if (r.remaining() != size_t(count) * words * 4)
+                throw Error(r.where() + ": size does not match its node count");
+            out.resize(size_t(count) * words);
+            for (size_t k = 0; k < out.size(); ++k)
+                if (!valid(out[k] = r.u32()))
+                    throw Error(strfmt("%s: word %zu is not valid", r.where().c_str(), k));
+            expect_end(r);
+        }
+    };
+    node_words(ID_OCC, 3, "occupancy masks", NB_OCC_WORDS, m.occupancy, [](uint32_t) { return true; });
+    // Fits: two finite fp16 per word.
+    node_words(ID_MFIT, 5, "material fits", NB_NODE_FIT_WORDS, m.material_fits,
+               [](uint32_t v) { return half_finite(uint16_t(v)) && half_finite(uint16_t(v >> 16)); });
     for (const SectionView& s : sections) {
         if (std::memcmp(s.id, ID_MATL, 4) != 0) continue;
         Reader r(s.bytes, name + ": section 'MATL'");

@@ -71,7 +71,8 @@ struct NeuralPlan {
     bool model_has_masks = false;
     bool backface_escape = false;  // --neural-backface-escape
     bool node_materials = false;   // hits shaded with their node's metallic/roughness (on and the model has them)
-    bool model_has_materials = false;
+    bool material_fits = false;    // ... as the node's fit in the predicted albedo (fit and the model has them)
+    bool model_has_materials = false, model_has_fits = false;
     uint32_t instances = 0, assets = 0;
 };
 

@@ -43,7 +43,7 @@ NeuralGpuBytes neural_gpu_bytes(const NeuralModel& model) {
     }
     b.node_bounds = uint64_t(model.nodes.size()) * 2 * sizeof(glm::vec3);
     b.occupancy = uint64_t(model.occupancy.size()) * sizeof(uint32_t); // after the bounds, same buffer
-    b.materials = uint64_t(model.node_materials.size()) * sizeof(uint32_t); // after the masks, same buffer
+    b.materials = uint64_t(model.node_materials.size() + model.material_fits.size()) * sizeof(uint32_t); // after the masks, same buffer
     b.assets = uint64_t(model.assets.size()) * sizeof(GpuNeuralAsset);
     b.params = sizeof(GpuNeuralParams);
     return b;

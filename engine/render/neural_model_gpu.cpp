@@ -144,7 +144,8 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
     // node materials (node_materials.h) in the same buffer (the set has no binding to spare: lavapipe
     // allows 32 storage buffers per stage); models without them have none.
     std::vector<uint32_t> words;
-    words.reserve(model.nodes.size() * 6 + model.occupancy.size() + model.node_materials.size());
+    words.reserve(model.nodes.size() * 6 + model.occupancy.size() + model.node_materials.size() +
+                  model.material_fits.size());
     for (const NbvhNode& n : model.nodes)
         for (const glm::vec3& v : {n.bounds.lo, n.bounds.hi})
             for (int k = 0; k < 3; ++k) words.push_back(floatBitsToUint(v[k]));
@@ -155,6 +156,10 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
     if (model.node_materials.size() == model.nodes.size()) {
         materials_offset_ = uint32_t(words.size());
         words.insert(words.end(), model.node_materials.begin(), model.node_materials.end());
+    }
+    if (model.material_fits.size() == model.nodes.size() * NB_NODE_FIT_WORDS) {
+        material_fits_offset_ = uint32_t(words.size());
+        words.insert(words.end(), model.material_fits.begin(), model.material_fits.end());
     }
     leaf_bounds_ = vk::make_buffer(ctx, words, "nbvh node bounds, occupancy and materials");
     box_ = encoding_box_of(model);

@@ -70,10 +70,12 @@ public:
     const vk::Buffer& mlp_transposed() const { return mlp_t_; } // cooperative-matrix kernels
     const vk::Buffer& nodes() const { return nodes_; }      // GpuBvhNode, all LoDs
     // vec3 lo, vec3 hi per N-BVH node, then (from word occupancy_offset()) NB_OCC_WORDS per node and
-    // (from word materials_offset()) one material word per node.
+    // (from word materials_offset()) one material word per node and (from material_fits_offset())
+    // NB_NODE_FIT_WORDS per node.
     const vk::Buffer& leaf_bounds() const { return leaf_bounds_; }
     uint32_t occupancy_offset() const { return occupancy_offset_; } // 0: the model has no masks
     uint32_t materials_offset() const { return materials_offset_; } // 0: no node materials
+    uint32_t material_fits_offset() const { return material_fits_offset_; } // 0: no material fits
     const GpuEncodingBox& box() const { return box_; }
     uint32_t lod_count() const { return asset_count_ ? uint32_t(roots_.size()) / asset_count_ : 0u; }
     uint32_t asset_count() const { return asset_count_; }
@@ -94,6 +96,7 @@ private:
     vk::Buffer levels_, grid_, mlp_, mlp_t_, nodes_, leaf_bounds_;
     uint32_t occupancy_offset_ = 0;
     uint32_t materials_offset_ = 0;
+    uint32_t material_fits_offset_ = 0;
     GpuEncodingBox box_{};
     std::vector<uint32_t> roots_;
     uint32_t asset_count_ = 0;

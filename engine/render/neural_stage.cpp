@@ -176,7 +176,8 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     params_.threshold = o.threshold;
     params_.max_rounds = o.max_rounds;
     params_.occupancy = o.occupancy ? model_.occupancy_offset() : 0u;
-    params_.materials = o.node_materials ? model_.materials_offset() : 0u;
+    params_.materials = o.materials != NeuralMaterials::asset ? model_.materials_offset() : 0u;
+    params_.material_fits = o.materials == NeuralMaterials::fit ? model_.material_fits_offset() : 0u;
 }
 
 void NeuralStage::update(const NeuralRenderOptions& o, vk::Buffer& params_buffer) {

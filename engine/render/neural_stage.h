@@ -31,6 +31,9 @@ namespace nbvh::render {
 inline constexpr int32_t SECONDARY_LOD_SAME = -1;     // the camera rays' LoD
 inline constexpr int32_t SECONDARY_LOD_COARSEST = -2; // the model's coarsest LoD (never finer than lod)
 
+// What a neural hit's metallic and roughness come from (engine/neural/node_materials.h).
+enum class NeuralMaterials { fit, node, asset };
+
 struct NeuralRenderOptions {
     const NeuralModel* model = nullptr; // hybrid render when set (and not classical)
     bool classical = false;             // reference: neural instances as triangles (the true scene)
@@ -60,9 +63,10 @@ struct NeuralRenderOptions {
     // Skip (ray, leaf) pairs whose segment crosses only empty cells of the leaf's occupancy mask
     // (shared/neural_occupancy.h; models without masks query every leaf). --neural-occupancy on|off.
     bool occupancy = true;
-    // Hits take the metallic/roughness of the N-BVH node that answered them (engine/neural/
-    // node_materials.h; models without them: the asset's). --neural-materials node|asset.
-    bool node_materials = true;
+    // Metallic/roughness of a hit (engine/neural/node_materials.h): its N-BVH node's fit in the
+    // predicted albedo, the node's mean, or the asset's mean; a model without fits (format 4) falls
+    // back to its means, one without either to the asset's. --neural-materials fit|node|asset.
+    NeuralMaterials materials = NeuralMaterials::fit;
     // A ray leaving a neural hit seen from behind (predicted normal along the incoming ray) skips
     // back-facing neural hits, so that it leaves the asset instead of bouncing inside it
     // (NB_RAY_BACKFACE_BIT, engine/render/NEURAL.md). --neural-backface-escape on|off.

@@ -1,9 +1,10 @@
 // The shading surface of a neural hit: position on the ray, the predicted normal (world space, turned
 // towards the incoming ray, used as geometric and shading normal), the predicted albedo as base colour
 // (it learned factor x texture), and the rest from the asset's glTF material: metallic and roughness
-// as factor x the texture's mean over the triangles of the N-BVH node that answered the hit
-// (engine/neural/node_materials.h; a neural hit has no uv), or over the whole asset for models without
-// per-node materials or with --neural-materials asset (asset_table.h asset_shading), transmission and
+// as factor x texture summarised over the triangles of the N-BVH node that answered the hit
+// (engine/neural/node_materials.h; a neural hit has no uv): a linear function of the predicted albedo
+// (default), their mean (--neural-materials node, models of format 4), or the whole asset's mean
+// (--neural-materials asset, models without per-node materials: asset_table.h asset_shading), transmission and
 // emission factors, unless the user overrides metallic/roughness (--neural-metallic,
 // --neural-roughness). Included by passes/shade.comp after lib/material.glsl.
 #ifndef NB_NEURAL_SURFACE_GLSL
@@ -24,7 +25,13 @@ Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t) {
     s.n = n;
     s.base = clamp(vec3(unpackHalf2x16(st.albedo_rg), unpackHalf2x16(st.albedo_b).x), 0.0f, 1.0f);
     vec2 mr = vec2(asset.metallic, asset.roughness);
-    if (neural_params.materials != 0u) mr = unpackUnorm2x16(nbvh_bounds_words[neural_params.materials + st.hit_leaf]);
+    if (neural_params.material_fits != 0u) {
+        uint b = neural_params.material_fits + NB_NODE_FIT_WORDS * st.hit_leaf;
+        mr = nb_node_fit_eval(unpackHalf2x16(nbvh_bounds_words[b]), unpackHalf2x16(nbvh_bounds_words[b + 1u]),
+                              unpackHalf2x16(nbvh_bounds_words[b + 2u]), unpackHalf2x16(nbvh_bounds_words[b + 3u]), s.base);
+    } else if (neural_params.materials != 0u) {
+        mr = unpackUnorm2x16(nbvh_bounds_words[neural_params.materials + st.hit_leaf]);
+    }
     float metallic = neural_params.metallic < 0.0f ? mr.x : neural_params.metallic;
     float roughness = neural_params.roughness < 0.0f ? mr.y : neural_params.roughness;
     s.metallic = clamp(metallic, 0.0f, 1.0f);

@@ -158,7 +158,9 @@ struct GpuNeuralParams {
     // Per-node materials (engine/neural/node_materials.h, nb_pack_node_material): their first word in
     // the same buffer, one word per node; 0 = none or off (hits take their asset's metallic/roughness).
     uint materials;
-    uint pad0;
+    // Per-node material fits (node_materials.h, nb_node_fit_eval): their first word in the same buffer,
+    // NB_NODE_FIT_WORDS per node; 0 = none or off (then `materials`). --neural-materials fit|node|asset.
+    uint material_fits;
     uint pad1;
     uint pad2;
 };
@@ -170,6 +172,15 @@ NB_FN uint nb_pack_node_material(float metallic, float roughness) {
     float m = metallic > 0.0f ? (metallic < 1.0f ? metallic : 1.0f) : 0.0f; // NaN -> 0
     float r = roughness > 0.0f ? (roughness < 1.0f ? roughness : 1.0f) : 0.0f;
     return uint(m * 65535.0f + 0.5f) | (uint(r * 65535.0f + 0.5f) << 16u);
+}
+
+// A node's metallic and roughness as linear functions of the hit's predicted albedo (node_materials.h):
+// NB_NODE_FIT_WORDS words of two fp16 each (GLSL unpackHalf2x16: low half first), (m0, m_r), (m_g, m_b),
+// (r0, r_r), (r_g, r_b): metallic = m0 + m_r r + m_g g + m_b b, roughness likewise, unclamped here.
+#define NB_NODE_FIT_WORDS 4u
+NB_FN vec2 nb_node_fit_eval(vec2 m01, vec2 m23, vec2 r01, vec2 r23, vec3 albedo) {
+    return vec2(m01.x + m01.y * albedo.x + m23.x * albedo.y + m23.y * albedo.z,
+                r01.x + r01.y * albedo.x + r23.x * albedo.y + r23.y * albedo.z);
 }
 
 struct GpuNeuralCounters {

@@ -39,10 +39,12 @@ NeuralModel with_tree(NeuralModel m, uint32_t depth, uint32_t lods, uint32_t rou
     return m;
 }
 
-// The tiny model with its optional sections: occupancy masks (OCCU) and node materials (MATL).
+// The tiny model with its optional sections: occupancy masks (OCCU), node materials (MATL) and
+// material fits (MFIT: fp16 0.5 and -1.0 in every word).
 NeuralModel with_masks_and_materials(NeuralModel m) {
     m.occupancy.assign(m.nodes.size() * NB_OCC_WORDS, 0x0F0F0F0Fu);
     for (uint32_t i = 0; i < m.nodes.size(); ++i) m.node_materials.push_back(nb_pack_node_material(0.2f * i, 1.0f - 0.1f * i));
+    m.material_fits.assign(m.nodes.size() * NB_NODE_FIT_WORDS, 0xBC003800u);
     return m;
 }
 

@@ -89,9 +89,10 @@ int main(int argc, char** argv) {
     }
     const int iterations = argc > 1 ? std::atoi(argv[1]) : 3000;
     const std::vector<uint8_t> model = nbvh::serialize_model(nbvh::test::make_tiny_model());
-    nbvh::NeuralModel rich = nbvh::test::make_tiny_model(); // with the optional sections OCCU and MATL
+    nbvh::NeuralModel rich = nbvh::test::make_tiny_model(); // with the optional sections OCCU, MATL and MFIT
     rich.occupancy.assign(rich.nodes.size() * NB_OCC_WORDS, 0x0F0F0F0Fu);
     rich.node_materials.assign(rich.nodes.size(), nb_pack_node_material(0.5f, 0.25f));
+    rich.material_fits.assign(rich.nodes.size() * NB_NODE_FIT_WORDS, 0xBC003800u); // fp16 0.5 and -1.0
     const std::vector<uint8_t> rich_bytes = nbvh::serialize_model(rich);
     std::vector<uint8_t> official(16 + 3 * 40 + 8, 0);
     const uint64_t three = 3, one = 1, left = 1, none = 0xFFFFFFFFull, leaf_code = 2;

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "engine/core/error.h"
+#include "engine/neural/fp16.h"
 #include "shaders/shared/neural_gpu.h"
 #include "shaders/shared/neural_occupancy.h"
 #include "tests/model/tiny_model.h"
@@ -129,7 +130,7 @@ TEST(ModelFile, SaveIsAtomicAndLoadReadsItBack) {
 // Pins the format: any change to the byte layout must bump MODEL_FORMAT_VERSION and this test.
 TEST(ModelFile, GoldenBytes) {
     const std::vector<uint8_t> b = serialize_model(make_tiny_model());
-    const uint8_t head[16] = {'N', 'B', 'V', 'H', 4, 0, 0, 0, 8, 0, 0, 0, 0, 0, 0, 0};
+    const uint8_t head[16] = {'N', 'B', 'V', 'H', 5, 0, 0, 0, 8, 0, 0, 0, 0, 0, 0, 0};
     ASSERT_GE(b.size(), 16u);
     EXPECT_EQ(std::memcmp(b.data(), head, 16), 0);
     std::vector<std::string> ids;
@@ -144,7 +145,7 @@ TEST(ModelFile, GoldenBytes) {
     const uint32_t node_head[2 + 10] = {5, 0, 0, 0, 0, 0x3f800000u, 0x3f800000u, 0x3f800000u, 1, 0, 0xFFu, 0};
     EXPECT_EQ(std::memcmp(b.data() + section_offset(b, "NODE"), node_head, sizeof(node_head)), 0);
     EXPECT_EQ(b.size(), 40984u);
-    EXPECT_EQ(fnv1a64(b.data(), b.size()), 0x03f899d3fe60a69bull) << std::hex << fnv1a64(b.data(), b.size());
+    EXPECT_EQ(fnv1a64(b.data(), b.size()), 0x300a879778e67b84ull) << std::hex << fnv1a64(b.data(), b.size());
 }
 
 // Occupancy masks (version 3): an optional section after META, written only when the model has masks,
@@ -197,6 +198,34 @@ TEST(ModelFile, NodeMaterialsAreAnOptionalSection) {
     EXPECT_THROW(parse_model(resized_section(b, "MATL", 8 + 5 * 4 - 4), "m.nbvh"), Error);
 }
 
+// Material fits (version 5): an optional section after MATL, NB_NODE_FIT_WORDS words of two fp16 per
+// node, read back exactly; refused in an older version's file, with the wrong node or word count, a
+// non-finite coefficient or a short payload; counted in the model's GPU bytes.
+TEST(ModelFile, MaterialFitsAreAnOptionalSection) {
+    NeuralModel a = make_tiny_model();
+    for (const auto& s : test::section_locations(serialize_model(a))) EXPECT_NE(s.id, "MFIT");
+    const uint64_t plain_bytes = model_gpu_bytes(a);
+    for (uint32_t i = 0; i < a.nodes.size(); ++i) a.node_materials.push_back(nb_pack_node_material(0.5f, 0.5f));
+    for (uint32_t i = 0; i < a.nodes.size() * NB_NODE_FIT_WORDS; ++i)
+        a.material_fits.push_back(uint32_t(float_to_half_bits(0.25f * i)) | uint32_t(float_to_half_bits(-2.0f)) << 16);
+    EXPECT_EQ(model_gpu_bytes(a) - plain_bytes, a.nodes.size() * (1 + NB_NODE_FIT_WORDS) * 4);
+    const std::vector<uint8_t> b = serialize_model(a);
+    std::vector<std::string> ids;
+    for (const auto& s : test::section_locations(b)) ids.push_back(s.id);
+    EXPECT_EQ(ids, (std::vector<std::string>{"CONF", "ASST", "LEVL", "LODS", "NODE", "MLP ", "GRID", "META", "MATL", "MFIT"}));
+    const uint32_t head[4] = {5, NB_NODE_FIT_WORDS, a.material_fits[0], a.material_fits[1]};
+    EXPECT_EQ(std::memcmp(b.data() + section_offset(b, "MFIT"), head, sizeof(head)), 0);
+    const NeuralModel back = parse_model(b);
+    EXPECT_EQ(back.material_fits, a.material_fits);
+    EXPECT_EQ(back.node_materials, a.node_materials);
+    expect_rejected(edited(b, 4, 4), "material fits need format version 5");
+    expect_rejected(edited(b, section_offset(b, "MFIT"), 4), "4 nodes x 4 words, the model has 5 nodes x 4");
+    expect_rejected(edited(b, section_offset(b, "MFIT") + 4, 1), "5 nodes x 1 words, the model has 5 nodes x 4");
+    expect_rejected(edited(b, section_offset(b, "MFIT") + 8 + 4 * 7, 0x7C00u), "word 7 is not valid"); // +inf
+    expect_rejected(edited(b, section_offset(b, "MFIT") + 8, 0x7E000000u), "word 0 is not valid");    // NaN high half
+    EXPECT_THROW(parse_model(resized_section(b, "MFIT", 8 + 5 * NB_NODE_FIT_WORDS * 4 - 4), "m.nbvh"), Error);
+}
+
 TEST(ModelFile, TruncationAnywhereIsRejected) {
     const std::vector<uint8_t> b = serialize_model(make_tiny_model());
     std::vector<size_t> cuts{0, 1, 3, 4, 16, 31, 32, 33, 64, 100};
@@ -243,9 +272,9 @@ TEST(ModelFile, ForeignFilesAreRejected) {
     expect_rejected(c, "not an nbvh model (bad magic)");
     expect_rejected({}, "not an nbvh model (file too short)");
     c = b;
-    poke<uint32_t>(c, 4, 5);
+    poke<uint32_t>(c, 4, MODEL_FORMAT_VERSION + 1);
     refresh_checksums(c);
-    expect_rejected(c, "unsupported model format version 5");
+    expect_rejected(c, "unsupported model format version " + std::to_string(MODEL_FORMAT_VERSION + 1));
     // An official N-BVH tree file (u64 N, u64 1, N x 40 bytes, u64 0) of 3 nodes.
     std::vector<uint8_t> official(16 + 3 * 40 + 8, 0);
     poke<uint64_t>(official, 0, 3);

@@ -19,6 +19,7 @@
 #include "engine/core/flip.h"
 #include "engine/core/image.h"
 #include "engine/neural/asset_table.h"
+#include "engine/neural/fp16.h"
 #include "engine/render/neural_stage.h"
 #include "engine/render/wavefront.h"
 #include "engine/scene/environment.h"
@@ -283,42 +284,55 @@ TEST(MultiAsset, BackfaceEscapeIsOffForTransmissiveAssets) {
 }
 
 // Per-node materials reach the shade pass through the leaf that answered the hit: every node of the
-// pillar's subtree made a rough metal (metallic 1, roughness 1: exact in unorm16), the others as built
-// (the scene has no textures: their words equal their asset's factors). Max depth 2 (camera hits and
-// their direct light), so a pixel depends on its own surface alone: the pillar's pixels match a render whose --neural-metallic 1
-// --neural-roughness 1 override every asset, the other nodes' match the per-asset render (only
-// silhouette pixels, mixed by the jittered samples, can differ). Control: the per-asset render's pillar.
+// pillar's subtree made a rough metal (means: metallic 1, roughness 1, exact in unorm16; fits: metallic
+// 4 (r + g + b), i.e. 1 once clamped for any albedo brighter than 0.25 in sum, so the albedo reaches
+// the evaluation, and roughness 1), the others as built (the scene has no textures: their means equal
+// their asset's factors, their fits have the factors as fp16 intercepts, 0.7998 for 0.8, and no slope:
+// the brick's samples then take other BSDF branches now and then, FLIP <= 0.009). Max depth 2 (camera
+// hits and their direct light), so a pixel depends on its own surface alone: the pillar's pixels match
+// a render whose --neural-metallic 1 --neural-roughness 1 override every asset, the other nodes' match
+// the per-asset render (only silhouette pixels, mixed by the jittered samples, can differ), in both
+// --neural-materials fit (default) and node. Control: the per-asset render's pillar.
 TEST(MultiAsset, NodeMaterialsShadeTheHitsOfTheirLeaves) {
     const Trained& t = trained();
     NeuralModel model = t.model;
     ASSERT_EQ(model.node_materials.size(), model.nodes.size());
+    ASSERT_EQ(model.material_fits.size(), model.nodes.size() * NB_NODE_FIT_WORDS);
     const uint32_t pillar = 3;
     ASSERT_EQ(model.assets[pillar].name, "pillar");
+    auto half2 = [](float lo, float hi) { return uint32_t(float_to_half_bits(lo)) | uint32_t(float_to_half_bits(hi)) << 16; };
+    const uint32_t fit[NB_NODE_FIT_WORDS] = {half2(0.0f, 4.0f), half2(4.0f, 4.0f), half2(1.0f, 0.0f), half2(0.0f, 0.0f)};
     std::vector<uint32_t> stack{model.assets[pillar].root};
     while (!stack.empty()) {
         const uint32_t i = stack.back();
         stack.pop_back();
         model.node_materials[i] = nb_pack_node_material(1.0f, 1.0f);
+        for (uint32_t k = 0; k < NB_NODE_FIT_WORDS; ++k) model.material_fits[i * NB_NODE_FIT_WORDS + k] = fit[k];
         if (model.nodes[i].has_children()) stack.insert(stack.end(), {model.nodes[i].left, model.nodes[i].left + 1});
     }
     LiveSetup s(model, SIZE, 5);
     s.options.max_depth = 2;
     s.options.spp = 4;
-    const Image node = convert_channels(s.fresh(s.options), 3);
     RenderOptions o = s.options;
-    o.neural.node_materials = false;
+    o.neural.materials = render::NeuralMaterials::asset;
     const Image asset = convert_channels(s.fresh(o), 3);
     o.neural.metallic = o.neural.roughness = 1.0f;
     const Image metal = convert_channels(s.fresh(o), 3);
-    const std::map<std::string, float> vs_metal = flip_per_node(s.scene, metal, node);
-    const std::map<std::string, float> vs_asset = flip_per_node(s.scene, asset, node);
     const std::map<std::string, float> control = flip_per_node(s.scene, metal, asset);
-    for (const auto& [name, e] : vs_asset) {
-        const float err = name == "pillar" ? vs_metal.at(name) : e;
-        std::printf("node %-8s FLIP %.4f (control: metal vs asset %.4f)\n", name.c_str(), err, control.at(name));
-        EXPECT_LT(err, 0.02f) << name;
-    }
     EXPECT_GT(control.at("pillar"), 0.1f);
+    for (render::NeuralMaterials mode : {render::NeuralMaterials::fit, render::NeuralMaterials::node}) {
+        o = s.options;
+        o.neural.materials = mode;
+        const Image node = convert_channels(s.fresh(o), 3);
+        const std::map<std::string, float> vs_metal = flip_per_node(s.scene, metal, node);
+        const std::map<std::string, float> vs_asset = flip_per_node(s.scene, asset, node);
+        for (const auto& [name, e] : vs_asset) {
+            const float err = name == "pillar" ? vs_metal.at(name) : e;
+            std::printf("%s: node %-8s FLIP %.4f (control: metal vs asset %.4f)\n",
+                        mode == render::NeuralMaterials::fit ? "fit " : "mean", name.c_str(), err, control.at(name));
+            EXPECT_LT(err, 0.02f) << name;
+        }
+    }
 }
 
 TEST(MultiAsset, AModelForAnotherSceneIsRefusedNamingTheAsset) {
