@@ -12,7 +12,7 @@
 #      always added as "classical"; FLIP compares each variant with the first), REPS (default 2), SPP (16),
 #      SCENES (default "default dragon"; chess needs .device/study/chess carried), DRAGON (xz-packed glb,
 #      default .device/study/dragon/dragon_vrip.glb.xz), WIDTH, HEIGHT,
-#      TRAIN_ARGS (extra `nbvh train` flags, e.g. a short CPU training for a dry run).
+#      TRAIN_ARGS (extra `nbvh train` flags, e.g. a short CPU training for a dry run), MAX_DEPTH (8).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 source scripts/bench/lib.sh
@@ -29,7 +29,7 @@ for scene in "${SC[@]}"; do
   bench_scene "$scene" "$T"
   "$B" train "${SRC[@]}" "${NEURAL[@]}" "${TA[@]}" --out "$T/$scene.nbvh" > "$OUT/train_$scene.log" 2>&1
 done
-R=(--width "${WIDTH:-1920}" --height "${HEIGHT:-1080}" --max-depth 8 --exposure 0 --spp "${SPP:-16}")
+R=(--width "${WIDTH:-1920}" --height "${HEIGHT:-1080}" --max-depth "${MAX_DEPTH:-8}" --exposure 0 --spp "${SPP:-16}")
 mapfile -t V <<< "${VARIANTS:?VARIANTS: lines NAME|FLAGS}"
 for scene in "${SC[@]}"; do
   bench_scene "$scene" "$T"

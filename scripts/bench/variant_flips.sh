@@ -15,7 +15,7 @@ mkdir -p "$OUT"
 REPS=${REPS:-3} scripts/bench/flag_sweep.sh "$OUT/sweep" > "$OUT/sweep.txt" 2>&1 || echo sweep failed
 T=${TMPDIR:-/tmp}/nbvh_sweep
 B=${NBVH:-.device/study/bin/nbvh}
-R=(--width "${FLIP_W:-960}" --height "${FLIP_H:-540}" --max-depth 8 --exposure 0 --spp "${FLIP_SPP:-2048}")
+R=(--width "${FLIP_W:-960}" --height "${FLIP_H:-540}" --max-depth "${MAX_DEPTH:-8}" --exposure 0 --spp "${FLIP_SPP:-2048}")
 mapfile -t V <<< "${VARIANTS:?VARIANTS: lines NAME|FLAGS}"
 # shellcheck disable=SC2206
 SC=(${SCENES:-default dragon})
