@@ -71,7 +71,9 @@ void print_model(const std::string& path) {
                 human_bytes(double(b.mlp)).c_str(), b.lod_nodes.size(), human_bytes(double(b.nodes)).c_str(),
                 human_bytes(double(b.node_bounds)).c_str(),
                 b.occupancy ? human_bytes(double(b.occupancy)).c_str() : "none (model before format version 3)",
-                b.materials ? human_bytes(double(b.materials)).c_str() : "none (model before format version 4)",
+                b.materials ? (human_bytes(double(b.materials)) + (m.material_fits.empty() ? " (means; fits from format version 5)"
+                                                                                           : " (means and fits)")).c_str()
+                            : "none (model before format version 4)",
                 human_bytes(double(b.levels)).c_str(),
                 human_bytes(double(b.assets)).c_str(), human_bytes(double(b.total_for_lod(0))).c_str());
     if (m.meta.source_triangles > 0) {

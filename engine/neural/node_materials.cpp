@@ -1,5 +1,6 @@
 #include "engine/neural/node_materials.h"
 
+#include <algorithm>
 #include <cmath>
 #include <unordered_map>
 
@@ -108,8 +109,9 @@ void pack_fit(const Moments& m, uint32_t out[NB_NODE_FIT_WORDS]) {
     for (int k = 0; k < 2; ++k) {
         float a0;
         glm::vec3 a;
-        if (!fit_output(m, k, a0, a)) {
-            a0 = float(m.y[k] / m.w);
+        if (!fit_output(m, k, a0, a)) { // the mean, or the defaults when even that is not finite
+            const double mean = m.y[k] / m.w;
+            a0 = std::isfinite(mean) ? float(std::clamp(mean, 0.0, 1.0)) : (k == 0 ? 0.0f : 1.0f);
             a = glm::vec3(0.0f);
         }
         out[2 * k] = pair(a0, a.x);

@@ -172,4 +172,12 @@ TEST(NodeMaterials, FitsStayFiniteOnDegenerateAlbedos) {
         EXPECT_NEAR(eval_fit(t.fits, n, glm::vec3(0.3f)).x, 0.5f, 1e-3f) << n;
         EXPECT_NEAR(eval_fit(t.fits, n, glm::vec3(0.3f)).y, 1.0f, 1e-3f) << n;
     }
+    // A non-finite factor (a hostile file): the defaults, never a NaN word (the reader would refuse
+    // the model the trainer just wrote).
+    q.scene.materials[0].metallic = NAN;
+    t = build_node_materials(nodes, b, q.scene.meshes[0], q.scene);
+    for (uint32_t n = 0; n < 3; ++n) {
+        EXPECT_EQ(eval_fit(t.fits, n, glm::vec3(0.3f)).x, 0.0f) << n;
+        EXPECT_NEAR(eval_fit(t.fits, n, glm::vec3(0.3f)).y, 1.0f, 1e-3f) << n;
+    }
 }
