@@ -193,6 +193,10 @@ TEST(ModelFile, NodeMaterialsAreAnOptionalSection) {
     EXPECT_EQ(back.node_materials, a.node_materials);
     EXPECT_EQ(back.occupancy, a.occupancy);
     expect_rejected(edited(b, 4, 3), "node materials need format version 4");
+    const NeuralModel v4 = parse_model(edited(b, 4, 4)); // a version-4 file (no fits) still loads
+    EXPECT_EQ(v4.node_materials, a.node_materials);
+    EXPECT_TRUE(v4.material_fits.empty());
+    EXPECT_EQ(v4.file_version, 4u);
     expect_rejected(edited(b, section_offset(b, "MATL"), 4), "4 nodes, the model has 5");
     expect_rejected(edited(b, section_offset(b, "MATL") + 4, 1), "reserved field is not zero");
     EXPECT_THROW(parse_model(resized_section(b, "MATL", 8 + 5 * 4 - 4), "m.nbvh"), Error);
