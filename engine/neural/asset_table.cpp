@@ -177,11 +177,14 @@ AssetShading asset_shading(const Scene& scene, uint32_t mesh) {
     for (uint32_t t = 0; t < m.triangle_count(); ++t) {
         const double a = triangle_material_points(scene, m, material, t, points);
         if (a <= 0.0) continue;
-        area += a;
+        double tm = 0.0, tr = 0.0; // per triangle first: the same sums as before the fits (bit for bit)
         for (const MaterialPoint& p : points) {
-            metallic += a / MATERIAL_POINTS * p.metallic;
-            roughness += a / MATERIAL_POINTS * p.roughness;
+            tm += a * 0.25 * double(p.metallic);
+            tr += a * 0.25 * double(p.roughness);
         }
+        area += a;
+        metallic += tm;
+        roughness += tr;
     }
     if (area > 0.0) {
         s.metallic = std::clamp(float(double(s.metallic) * metallic / area), 0.0f, 1.0f);

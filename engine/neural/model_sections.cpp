@@ -228,6 +228,7 @@ std::vector<Section> encode_sections(const NeuralModel& m) {
     // Optional per-node tables: node count, words per node, the words.
     auto node_words = [&](const char id[4], const std::vector<uint32_t>& words, uint32_t per_node) {
         if (words.empty()) return;
+        NBVH_CHECK(words.size() == m.nodes.size() * size_t(per_node));
         b.clear();
         Writer w(b);
         w.u32(uint32_t(m.nodes.size()));

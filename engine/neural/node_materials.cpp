@@ -34,8 +34,9 @@ struct Moments {
 };
 
 Moments triangle_moments(const Scene& scene, const Mesh& mesh, uint32_t t) {
-    Material fallback; // an out-of-range material: asset_shading's defaults
+    Material fallback; // an out-of-range material: asset_shading's defaults, the ground truth's albedo 0.9
     fallback.metallic = 0.0f;
+    fallback.base_color = glm::vec4(0.9f, 0.9f, 0.9f, 1.0f);
     const uint32_t mat = t < mesh.triangle_material.size() ? mesh.triangle_material[t] : 0u;
     const Material& m = mat < scene.materials.size() ? scene.materials[mat] : fallback;
     MaterialPoint points[MATERIAL_POINTS];

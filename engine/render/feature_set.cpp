@@ -139,6 +139,7 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
     p.material_fits = stage.params().material_fits != 0u;
     p.model_has_materials = !o.model->node_materials.empty();
     p.model_has_fits = !o.model->material_fits.empty();
+    p.fits_requested = o.materials == NeuralMaterials::fit;
     for (const Instance& inst : scene.instances) p.instances += inst.neural;
     p.assets = uint32_t(o.model->assets.size());
     return p;
@@ -212,8 +213,8 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
                                               : n->model_has_masks ? "off (--neural-occupancy off)"
                                                                    : "off (the model has no masks: format version < 3 or built without its triangles)");
         s += strfmt("  materials       %s\n", n->material_fits        ? "per node, fit (metallic/roughness of the N-BVH node that answered the hit, linear in its predicted albedo)"
-                                              : n->node_materials     ? (n->model_has_fits ? "per node, mean (--neural-materials node)"
-                                                                                           : "per node, mean (the model has no fits: format version < 5)")
+                                              : n->node_materials     ? (n->fits_requested ? "per node, mean (the model has no fits: format version < 5)"
+                                                                                           : "per node, mean (--neural-materials node)")
                                               : n->model_has_materials ? "per asset (--neural-materials asset)"
                                                                        : "per asset (the model has no node materials: format version < 4 or built without its triangles)");
         s += strfmt("  back-face escape %s\n", n->backface_escape ? "on  (rays leaving a hit seen from behind skip back faces)"

@@ -151,10 +151,11 @@ TEST(NodeMaterials, FitsStayFiniteOnDegenerateAlbedos) {
     const std::vector<NbvhNode> nodes = {node(0, 1), node(b.nodes[0].left), node(b.nodes[0].right)};
     q.scene.textures[1].rgba8 = {128, 128, 128, 255, 128, 128, 129, 255}; // albedos 1/255 apart (sRGB)
     NodeMaterialTables t = build_node_materials(nodes, b, q.scene.meshes[0], q.scene);
-    for (uint32_t w : t.fits) {
-        EXPECT_TRUE(std::isfinite(half_bits_to_float(uint16_t(w))) && std::isfinite(half_bits_to_float(uint16_t(w >> 16))));
-        EXPECT_LT(std::abs(half_bits_to_float(uint16_t(w))), 100.0f);
-    }
+    for (uint32_t w : t.fits)
+        for (float h : {half_bits_to_float(uint16_t(w)), half_bits_to_float(uint16_t(w >> 16))}) {
+            EXPECT_TRUE(std::isfinite(h));
+            EXPECT_LT(std::abs(h), 100.0f);
+        }
     const glm::vec3 grey(nb_srgb_to_linear(128.0f / 255.0f));
     EXPECT_NEAR(eval_fit(t.fits, 0, grey).x, 0.25f, 0.02f); // too close to tell apart: about the mean
     EXPECT_NEAR(eval_fit(t.fits, 0, grey).y, 0.5f, 0.02f);
@@ -179,5 +180,44 @@ TEST(NodeMaterials, FitsStayFiniteOnDegenerateAlbedos) {
     for (uint32_t n = 0; n < 3; ++n) {
         EXPECT_EQ(eval_fit(t.fits, n, glm::vec3(0.3f)).x, 0.0f) << n;
         EXPECT_NEAR(eval_fit(t.fits, n, glm::vec3(0.3f)).y, 1.0f, 1e-3f) << n;
+    }
+}
+
+// The subtree sums over a deeper base BVH (one triangle per leaf, 3 levels): every base node as an
+// N-BVH node, its mean against a brute-force sum over the triangles under it (the iterative post-order
+// of node_materials.cpp must add each child exactly once).
+TEST(NodeMaterials, EveryBaseNodeSumsExactlyItsSubtree) {
+    TwoQuads q = two_quads();
+    BvhBuildOptions o;
+    o.max_leaf_size = 1;
+    q.bvh = build_mesh_bvh(q.scene.meshes[0], o);
+    const Bvh& b = q.bvh.bvh;
+    ASSERT_EQ(b.nodes.size(), 7u);
+    std::vector<NbvhNode> nodes;
+    for (uint32_t i = 0; i < b.nodes.size(); ++i) nodes.push_back(node(i));
+    const NodeMaterialTables t = build_node_materials(nodes, b, q.scene.meshes[0], q.scene);
+    ASSERT_EQ(t.means.size(), nodes.size());
+    for (uint32_t i = 0; i < b.nodes.size(); ++i) {
+        double area = 0.0, metallic = 0.0, roughness = 0.0;
+        std::vector<uint32_t> stack{i};
+        while (!stack.empty()) {
+            const BvhNode& n = b.nodes[stack.back()];
+            stack.pop_back();
+            if (!n.is_leaf()) {
+                stack.insert(stack.end(), {n.left, n.right});
+                continue;
+            }
+            for (uint32_t k = n.first; k < n.first + n.count; ++k) {
+                MaterialPoint p[MATERIAL_POINTS];
+                const double a = triangle_material_points(q.scene, q.scene.meshes[0], q.scene.materials[0], b.prim_indices[k], p);
+                area += a;
+                for (const MaterialPoint& x : p) {
+                    metallic += a / MATERIAL_POINTS * x.metallic * 0.5; // metallic factor 0.5
+                    roughness += a / MATERIAL_POINTS * x.roughness;
+                }
+            }
+        }
+        ASSERT_GT(area, 0.0);
+        EXPECT_EQ(t.means[i], nb_pack_node_material(float(metallic / area), float(roughness / area))) << "base node " << i;
     }
 }
