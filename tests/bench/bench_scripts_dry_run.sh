@@ -14,7 +14,7 @@ python3 - "$W/out" <<'PY'
 import json, math, re, sys
 out = sys.argv[1]
 rows = json.load(open(out + "/sweep/sweep.json"))["rows"]
-assert sorted(rows) == ["default_asset", "default_classical", "default_node"], sorted(rows)
+assert sorted(rows) == ["default_classical", "default_fit", "default_node"], sorted(rows)
 for k, r in rows.items():
     assert math.isfinite(r["ms_per_spp"]) and r["ms_per_spp"] > 0, (k, r["ms_per_spp"])
 line = open(out + "/flips.txt").read()
