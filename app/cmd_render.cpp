@@ -73,7 +73,8 @@ nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o
                        {"leaves_per_round", n.leaves_per_round},
                        {"batched_rounds", n.batched_rounds},
                        {"occupancy", n.occupancy},
-                       {"materials", n.materials == render::NeuralMaterials::fit    ? "fit"
+                       {"materials", n.materials == render::NeuralMaterials::mix    ? "mix"
+                                     : n.materials == render::NeuralMaterials::fit  ? "fit"
                                      : n.materials == render::NeuralMaterials::node ? "node"
                                                                                      : "asset"},
                        {"backface_escape", n.backface_escape},

@@ -35,14 +35,16 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
     cmd->add_option_function<std::string>(
            "--neural-materials",
            [&o](const std::string& v) {
-               o.neural.materials = v == "fit"    ? render::NeuralMaterials::fit
+               o.neural.materials = v == "mix"    ? render::NeuralMaterials::mix
+                                    : v == "fit"  ? render::NeuralMaterials::fit
                                     : v == "node" ? render::NeuralMaterials::node
                                                   : render::NeuralMaterials::asset;
            },
            "metallic and roughness of a neural hit, from the triangles of the N-BVH node that answered it: "
-           "a linear function of the hit's predicted albedo (fit, default; models before format version 5 "
-           "use node), their mean (node; before version 4: asset), or the whole asset's mean (asset)")
-        ->check(CLI::IsMember({"fit", "node", "asset"}));
+           "a linear function of the hit's predicted albedo plus a random two-point spread of what it leaves "
+           "(mix, default), the function alone (fit; models before format version 5 use node), their mean "
+           "(node; before version 4: asset), or the whole asset's mean (asset)")
+        ->check(CLI::IsMember({"mix", "fit", "node", "asset"}));
     cmd->add_option_function<std::string>(
            "--neural-backface-escape", [&o](const std::string& v) { o.neural.backface_escape = v == "on"; },
            "a ray leaving a neural hit seen from behind skips back-facing neural hits, so that it leaves the "

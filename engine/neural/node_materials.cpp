@@ -23,6 +23,7 @@ struct Moments {
     glm::dmat3 cc{0.0};                            // sum w * albedo albedo^T
     glm::dvec2 y{0.0};                             // sum w * (metallic, roughness)
     glm::dvec3 cy[2] = {glm::dvec3(0.0), glm::dvec3(0.0)}; // sum w * albedo * metallic, ... * roughness
+    glm::dvec3 yy{0.0};                            // sum w * (metallic^2, roughness^2, metallic roughness)
     void add(const Moments& o) {
         w += o.w;
         c += o.c;
@@ -30,6 +31,7 @@ struct Moments {
         y += o.y;
         cy[0] += o.cy[0];
         cy[1] += o.cy[1];
+        yy += o.yy;
     }
 };
 
@@ -53,6 +55,7 @@ Moments triangle_moments(const Scene& scene, const Mesh& mesh, uint32_t t) {
         x.y += w * y;
         x.cy[0] += (w * y.x) * c;
         x.cy[1] += (w * y.y) * c;
+        x.yy += w * glm::dvec3(y.x * y.x, y.y * y.y, y.x * y.y);
     }
     return x;
 }
@@ -105,8 +108,27 @@ bool fit_output(const Moments& m, int k, float& a0, glm::vec3& a) {
            std::abs(slope.x) < 60000.0 && std::abs(slope.y) < 60000.0 && std::abs(slope.z) < 60000.0;
 }
 
+// Second moments of the fits' residuals, E[(y_k - theta_k . x)(y_l - theta_l . x)] with x = (1, albedo):
+// (metallic variance, roughness variance, their covariance).
+glm::dvec3 residual_moments(const Moments& m, const glm::dvec4 theta[2]) {
+    const glm::dvec3 cbar = m.c / m.w;
+    const glm::dmat3 cc = m.cc / m.w;
+    glm::dmat4 xx(1.0); // E[x x^T]
+    for (int r = 0; r < 3; ++r) {
+        xx[0][r + 1] = xx[r + 1][0] = cbar[r];
+        for (int c = 0; c < 3; ++c) xx[c + 1][r + 1] = cc[c][r];
+    }
+    const glm::dvec4 xy[2] = {glm::dvec4(m.y.x / m.w, m.cy[0] / m.w), glm::dvec4(m.y.y / m.w, m.cy[1] / m.w)};
+    const double yy[3] = {m.yy.x / m.w, m.yy.y / m.w, m.yy.z / m.w};
+    auto second = [&](int k, int l, double ykl) {
+        return ykl - glm::dot(theta[l], xy[k]) - glm::dot(theta[k], xy[l]) + glm::dot(theta[k], xx * theta[l]);
+    };
+    return {second(0, 0, yy[0]), second(1, 1, yy[1]), second(0, 1, yy[2])};
+}
+
 void pack_fit(const Moments& m, uint32_t out[NB_NODE_FIT_WORDS]) {
     auto pair = [](float lo, float hi) { return uint32_t(float_to_half_bits(lo)) | (uint32_t(float_to_half_bits(hi)) << 16); };
+    glm::dvec4 theta[2];
     for (int k = 0; k < 2; ++k) {
         float a0;
         glm::vec3 a;
@@ -117,7 +139,14 @@ void pack_fit(const Moments& m, uint32_t out[NB_NODE_FIT_WORDS]) {
         }
         out[2 * k] = pair(a0, a.x);
         out[2 * k + 1] = pair(a.y, a.z);
+        theta[k] = glm::dvec4(a0, a);
     }
+    // What the fit leaves: spread +-sigma per output, the roughness's sign that of the covariance (gold
+    // trim smooth and metallic: the two move against each other). Non-finite: none.
+    const glm::dvec3 r = residual_moments(m, theta);
+    const double sm = std::sqrt(std::max(r.x, 0.0)), sr = std::sqrt(std::max(r.y, 0.0));
+    const bool ok = std::isfinite(sm) && std::isfinite(sr) && std::isfinite(r.z) && sm < 2.0 && sr < 2.0;
+    out[4] = ok ? pair(float(sm), float(r.z < 0.0 ? -sr : sr)) : 0u;
 }
 
 } // namespace

@@ -139,7 +139,8 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
     p.material_fits = stage.params().material_fits != 0u;
     p.model_has_materials = !o.model->node_materials.empty();
     p.model_has_fits = !o.model->material_fits.empty();
-    p.fits_requested = o.materials == NeuralMaterials::fit;
+    p.fits_requested = o.materials == NeuralMaterials::fit || o.materials == NeuralMaterials::mix;
+    p.material_spread = stage.params().material_spread != 0u;
     for (const Instance& inst : scene.instances) p.instances += inst.neural;
     p.assets = uint32_t(o.model->assets.size());
     return p;
@@ -212,7 +213,8 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
         s += strfmt("  occupancy masks %s\n", n->occupancy          ? "on  (leaves crossing only empty cells are not queried)"
                                               : n->model_has_masks ? "off (--neural-occupancy off)"
                                                                    : "off (the model has no masks: format version < 3 or built without its triangles)");
-        s += strfmt("  materials       %s\n", n->material_fits        ? "per node, fit (metallic/roughness of the N-BVH node that answered the hit, linear in its predicted albedo)"
+        s += strfmt("  materials       %s\n", n->material_spread      ? "per node, fit + spread (metallic/roughness of the N-BVH node that answered the hit, linear in its predicted albedo, +- what the fit leaves)"
+                                              : n->material_fits        ? "per node, fit (--neural-materials fit: metallic/roughness of the N-BVH node that answered the hit, linear in its predicted albedo)"
                                               : n->node_materials     ? (n->fits_requested ? "per node, mean (the model has no fits: format version < 5)"
                                                                                            : "per node, mean (--neural-materials node)")
                                               : n->model_has_materials ? "per asset (--neural-materials asset)"

@@ -73,7 +73,8 @@ struct NeuralPlan {
     bool node_materials = false;   // hits shaded with their node's metallic/roughness (on and the model has them)
     bool material_fits = false;    // ... as the node's fit in the predicted albedo (fit and the model has them)
     bool model_has_materials = false, model_has_fits = false;
-    bool fits_requested = false;   // --neural-materials fit (the default)
+    bool fits_requested = false;   // --neural-materials mix (the default) or fit
+    bool material_spread = false;  // ... plus the fit's spread (mix and the model has fits)
     uint32_t instances = 0, assets = 0;
 };
 

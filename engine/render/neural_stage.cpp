@@ -177,7 +177,9 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     params_.max_rounds = o.max_rounds;
     params_.occupancy = o.occupancy ? model_.occupancy_offset() : 0u;
     params_.materials = o.materials != NeuralMaterials::asset ? model_.materials_offset() : 0u;
-    params_.material_fits = o.materials == NeuralMaterials::fit ? model_.material_fits_offset() : 0u;
+    const bool fits = o.materials == NeuralMaterials::fit || o.materials == NeuralMaterials::mix;
+    params_.material_fits = fits ? model_.material_fits_offset() : 0u;
+    params_.material_spread = o.materials == NeuralMaterials::mix && params_.material_fits != 0u ? 1u : 0u;
 }
 
 void NeuralStage::update(const NeuralRenderOptions& o, vk::Buffer& params_buffer) {

@@ -32,7 +32,7 @@ inline constexpr int32_t SECONDARY_LOD_SAME = -1;     // the camera rays' LoD
 inline constexpr int32_t SECONDARY_LOD_COARSEST = -2; // the model's coarsest LoD (never finer than lod)
 
 // What a neural hit's metallic and roughness come from (engine/neural/node_materials.h).
-enum class NeuralMaterials { fit, node, asset };
+enum class NeuralMaterials { mix, fit, node, asset };
 
 struct NeuralRenderOptions {
     const NeuralModel* model = nullptr; // hybrid render when set (and not classical)
@@ -66,7 +66,7 @@ struct NeuralRenderOptions {
     // Metallic/roughness of a hit (engine/neural/node_materials.h): its N-BVH node's fit in the
     // predicted albedo, the node's mean, or the asset's mean; a model without fits (format 4) falls
     // back to its means, one without either to the asset's. --neural-materials fit|node|asset.
-    NeuralMaterials materials = NeuralMaterials::fit;
+    NeuralMaterials materials = NeuralMaterials::mix;
     // A ray leaving a neural hit seen from behind (predicted normal along the incoming ray) skips
     // back-facing neural hits, so that it leaves the asset instead of bouncing inside it
     // (NB_RAY_BACKFACE_BIT, engine/render/NEURAL.md). --neural-backface-escape on|off.

@@ -11,7 +11,8 @@
 #define NB_NEURAL_SURFACE_GLSL
 #include "lib/neural_bindings.glsl"
 
-Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t) {
+// random_bits: a hash of the path's sampler state (the spread's sign; the stream is not advanced).
+Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t, uint random_bits) {
     GpuNeuralRayState st = neural_state[ray];
     Surface s;
     GpuNeuralAsset asset = neural_assets[instances[st.instance].blas_root];
@@ -29,6 +30,8 @@ Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t) {
         uint b = neural_params.material_fits + NB_NODE_FIT_WORDS * st.hit_leaf;
         mr = nb_node_fit_eval(unpackHalf2x16(nbvh_bounds_words[b]), unpackHalf2x16(nbvh_bounds_words[b + 1u]),
                               unpackHalf2x16(nbvh_bounds_words[b + 2u]), unpackHalf2x16(nbvh_bounds_words[b + 3u]), s.base);
+        if (neural_params.material_spread != 0u)
+            mr = nb_node_fit_spread(mr, unpackHalf2x16(nbvh_bounds_words[b + 4u]), random_bits);
     } else if (neural_params.materials != 0u) {
         mr = unpackUnorm2x16(nbvh_bounds_words[neural_params.materials + st.hit_leaf]);
     }

@@ -43,7 +43,7 @@ void main() {
     }
     float t = uintBitsToFloat(hit_load1(NB_HIT_T, i));
     uint tri_index = hit_load1(NB_HIT_TRIANGLE, i);
-    Surface s = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE) ? nb_make_neural_surface(i, org, dir, t)
+    Surface s = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE) ? nb_make_neural_surface(i, org, dir, t, nb_pcg_hash(rng ^ 0xA511E9B3u))
                                                                    : nb_make_surface(instance, tri_index, hit_load_bary(i), org, dir, t);
     vec3 wo = -dir;
 

@@ -161,7 +161,8 @@ struct GpuNeuralParams {
     // Per-node material fits (node_materials.h, nb_node_fit_eval): their first word in the same buffer,
     // NB_NODE_FIT_WORDS per node; 0 = none or off (then `materials`). --neural-materials fit|node|asset.
     uint material_fits;
-    uint pad1;
+    // 1: a hit's metallic/roughness also takes the fit's spread (nb_node_fit_spread), --neural-materials mix.
+    uint material_spread;
     uint pad2;
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 80, "GpuNeuralParams layout");
@@ -176,11 +177,18 @@ NB_FN uint nb_pack_node_material(float metallic, float roughness) {
 
 // A node's metallic and roughness as linear functions of the hit's predicted albedo (node_materials.h):
 // NB_NODE_FIT_WORDS words of two fp16 each (GLSL unpackHalf2x16: low half first), (m0, m_r), (m_g, m_b),
-// (r0, r_r), (r_g, r_b): metallic = m0 + m_r r + m_g g + m_b b, roughness likewise, unclamped here.
-#define NB_NODE_FIT_WORDS 4u
+// (r0, r_r), (r_g, r_b): metallic = m0 + m_r r + m_g g + m_b b, roughness likewise, unclamped here;
+// then (s_m, s_r): the spread of what the fit leaves (residual standard deviations; s_r negative when
+// the residuals of metallic and roughness are anti-correlated). A hit takes fit + sign * spread with a
+// random sign (a two-point mixture of the node's texels' materials: their mean and variance).
+#define NB_NODE_FIT_WORDS 5u
 NB_FN vec2 nb_node_fit_eval(vec2 m01, vec2 m23, vec2 r01, vec2 r23, vec3 albedo) {
     return vec2(m01.x + m01.y * albedo.x + m23.x * albedo.y + m23.y * albedo.z,
                 r01.x + r01.y * albedo.x + r23.x * albedo.y + r23.y * albedo.z);
+}
+NB_FN vec2 nb_node_fit_spread(vec2 fit, vec2 spread, uint random_bits) {
+    float s = (random_bits & 1u) != 0u ? 1.0f : -1.0f;
+    return fit + s * spread;
 }
 
 struct GpuNeuralCounters {

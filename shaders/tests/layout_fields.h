@@ -107,7 +107,7 @@
 #define NB_LAYOUT_FIELDS_GpuNeuralParams(F)                                                       \
     F(box.center) F(box.depth_pad) F(box.extent) F(box.fixed_depth_eps) F(lod_primary)            \
     F(lod_secondary) F(roughness) F(metallic) F(threshold) F(max_rounds) F(leaves_per_round) F(occupancy) \
-    F(materials) F(material_fits) F(pad1) F(pad2)
+    F(materials) F(material_fits) F(material_spread) F(pad2)
 #define NB_LAYOUT_FIELDS_GpuNeuralCounters(F) F(pending_active) F(queries_total) F(leaf_cap_rays) F(rounds) F(queries_total_hi) F(pad0) F(pad1) F(pad2)
 #define NB_LAYOUT_FIELDS_GpuNeuralAsset(F)                                                        \
     F(roots[0]) F(roots[1]) F(roots[2]) F(roots[3]) F(roots[4]) F(roots[5]) F(roots[6]) F(roots[7]) \

@@ -223,8 +223,8 @@ TEST(ModelFile, MaterialFitsAreAnOptionalSection) {
     EXPECT_EQ(back.material_fits, a.material_fits);
     EXPECT_EQ(back.node_materials, a.node_materials);
     expect_rejected(edited(b, 4, 4), "material fits need format version 5");
-    expect_rejected(edited(b, section_offset(b, "MFIT"), 4), "4 nodes x 4 words, the model has 5 nodes x 4");
-    expect_rejected(edited(b, section_offset(b, "MFIT") + 4, 1), "5 nodes x 1 words, the model has 5 nodes x 4");
+    expect_rejected(edited(b, section_offset(b, "MFIT"), 4), "4 nodes x 5 words, the model has 5 nodes x 5");
+    expect_rejected(edited(b, section_offset(b, "MFIT") + 4, 1), "5 nodes x 1 words, the model has 5 nodes x 5");
     expect_rejected(edited(b, section_offset(b, "MFIT") + 8 + 4 * 7, 0x7C00u), "word 7 is not valid"); // +inf
     expect_rejected(edited(b, section_offset(b, "MFIT") + 8, 0x7E000000u), "word 0 is not valid");    // NaN high half
     EXPECT_THROW(parse_model(resized_section(b, "MFIT", 8 + 5 * NB_NODE_FIT_WORDS * 4 - 4), "m.nbvh"), Error);

@@ -221,3 +221,36 @@ TEST(NodeMaterials, EveryBaseNodeSumsExactlyItsSubtree) {
         EXPECT_EQ(t.means[i], nb_pack_node_material(float(metallic / area), float(roughness / area))) << "base node " << i;
     }
 }
+
+// What the fit leaves: one albedo for both quads (no slope can tell them apart), so the root's fit is
+// the mean (0.25, 0.5) and its spread the two quads' deviations, metallic +-0.25 against roughness -+0.5
+// (anti-correlated: s_r negative): the two signs give back each quad's material exactly. A leaf of one
+// material has no spread.
+TEST(NodeMaterials, SpreadGivesBackWhatTheFitCannotTellApart) {
+    TwoQuads q = two_quads();
+    q.scene.textures[1].rgba8 = {200, 200, 200, 255, 200, 200, 200, 255};
+    const Bvh& b = q.bvh.bvh;
+    const bool left_first = b.nodes[b.nodes[0].left].bounds.lo.x < 0.0f;
+    const uint32_t left_quad = left_first ? b.nodes[0].left : b.nodes[0].right;
+    const uint32_t right_quad = left_first ? b.nodes[0].right : b.nodes[0].left;
+    const std::vector<NbvhNode> nodes = {node(0, 1), node(left_quad), node(right_quad, 3), node(BVH_INVALID),
+                                         node(BVH_INVALID)};
+    const NodeMaterialTables t = build_node_materials(nodes, b, q.scene.meshes[0], q.scene);
+    auto spread = [&](uint32_t n) {
+        const uint32_t w = t.fits[n * NB_NODE_FIT_WORDS + 4];
+        return glm::vec2(half_bits_to_float(uint16_t(w)), half_bits_to_float(uint16_t(w >> 16)));
+    };
+    const glm::vec3 grey(nb_srgb_to_linear(200.0f / 255.0f));
+    const glm::vec2 fit = eval_fit(t.fits, 0, grey);
+    EXPECT_NEAR(spread(0).x, 0.25f, 1e-3f);
+    EXPECT_NEAR(spread(0).y, -0.5f, 1e-3f);
+    const glm::vec2 minus = nb_node_fit_spread(fit, spread(0), 0u), plus = nb_node_fit_spread(fit, spread(0), 1u);
+    EXPECT_NEAR(minus.x, 0.0f, 2e-3f); // the left quad: metallic 0, roughness 1
+    EXPECT_NEAR(minus.y, 1.0f, 2e-3f);
+    EXPECT_NEAR(plus.x, 0.5f, 2e-3f); // the right quad: metallic 0.5 (factor), roughness 0
+    EXPECT_NEAR(plus.y, 0.0f, 2e-3f);
+    for (uint32_t n : {1u, 2u, 3u}) { // leaves of one material, and a node inheriting from one
+        EXPECT_NEAR(spread(n).x, 0.0f, 1e-3f) << n;
+        EXPECT_NEAR(spread(n).y, 0.0f, 1e-3f) << n;
+    }
+}

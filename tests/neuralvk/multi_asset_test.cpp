@@ -293,8 +293,8 @@ TEST(MultiAsset, BackfaceEscapeIsOffForTransmissiveAssets) {
 // hits and their direct light), so a pixel depends on its own surface alone: the pillar's pixels match
 // a render whose --neural-metallic 1 --neural-roughness 0.25 override every asset, the other nodes' match
 // the per-asset render (only silhouette pixels, mixed by the jittered samples, can differ), in both
-// --neural-materials fit (default) and node, and in fit mode for a model without fits (format 4: the
-// means). Control: the per-asset render's pillar.
+// --neural-materials mix (default), fit and node, and in fit mode for a model without fits (format 4:
+// the means). Control: the per-asset render's pillar.
 TEST(MultiAsset, NodeMaterialsShadeTheHitsOfTheirLeaves) {
     const Trained& t = trained();
     NeuralModel model = t.model;
@@ -328,10 +328,14 @@ TEST(MultiAsset, NodeMaterialsShadeTheHitsOfTheirLeaves) {
     LiveSetup v4(means_only, SIZE, 5);
     v4.options.max_depth = 2;
     v4.options.spp = 4;
-    const std::pair<const char*, LiveSetup*> runs[] = {{"fit", &s}, {"mean", &s}, {"fit, no fits", &v4}};
-    for (const auto& [label, setup] : runs) {
+    const std::tuple<const char*, LiveSetup*, render::NeuralMaterials> runs[] = {
+        {"mix", &s, render::NeuralMaterials::mix}, // the spread is 0 here: every node of the pillar one material
+        {"fit", &s, render::NeuralMaterials::fit},
+        {"mean", &s, render::NeuralMaterials::node},
+        {"fit, no fits", &v4, render::NeuralMaterials::fit}};
+    for (const auto& [label, setup, mode] : runs) {
         o = setup->options;
-        o.neural.materials = std::string(label) == "mean" ? render::NeuralMaterials::node : render::NeuralMaterials::fit;
+        o.neural.materials = mode;
         const Image node = convert_channels(setup->fresh(o), 3);
         const std::map<std::string, float> vs_metal = flip_per_node(s.scene, metal, node);
         const std::map<std::string, float> vs_asset = flip_per_node(s.scene, asset, node);
