@@ -4,13 +4,16 @@
 // asset_table.h triangle_material_points), two ways:
 //  - means: factor x texture averaged (one word per node, section MATL, format 4);
 //  - fits: factor x texture as a linear function of the albedo the network learned (4 fp16 per output,
-//    ridge-regularised least squares, section MFIT, format 5), evaluated at the hit's predicted albedo.
+//    ridge-regularised least squares, section MFIT, format 5), evaluated at the hit's predicted albedo,
+//    and the spread of what the fit leaves (residual standard deviations, the roughness's sign that of
+//    their covariance): with --neural-materials mix (default) a hit takes fit +- spread, a random sign
+//    (a two-point mixture with the texels' mean and variance: a polished texel's highlight survives).
 //    Chess's pieces are wood with gold trim and white or black paint in one texture: within one leaf
 //    the mean blends them, the albedo tells them apart (scripts/bench/material_fit.py: RMS error of
 //    metallic+roughness 0.09-0.24 per leaf mean -> 0.03-0.14 per leaf fit).
 // The paper and the official code shade every hit with global constants; averaging over a whole asset
 // (asset_table.h asset_shading) turns Chess's gold crowns into the pieces' wood. Built at the end of
-// training, read by the shade pass (lib/neural_surface.glsl) as --neural-materials fit|node|asset says.
+// training, read by the shade pass (lib/neural_surface.glsl) as --neural-materials mix|fit|node|asset says.
 #pragma once
 #include <cstdint>
 #include <span>
@@ -29,7 +32,7 @@ inline constexpr double NODE_MATERIAL_RIDGE = 1.0e-3;
 
 struct NodeMaterialTables {
     std::vector<uint32_t> means; // one word per node (shared/neural_gpu.h nb_pack_node_material)
-    std::vector<uint32_t> fits;  // NB_NODE_FIT_WORDS per node (nb_pack_node_fit)
+    std::vector<uint32_t> fits;  // NB_NODE_FIT_WORDS per node (shared/neural_gpu.h nb_node_fit_eval, _spread)
 };
 
 // Both tables for `nodes`, whose base_node index `base` (a BVH over the triangles of `mesh`, the

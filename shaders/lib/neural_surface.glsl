@@ -3,7 +3,8 @@
 // (it learned factor x texture), and the rest from the asset's glTF material: metallic and roughness
 // as factor x texture summarised over the triangles of the N-BVH node that answered the hit
 // (engine/neural/node_materials.h; a neural hit has no uv): a linear function of the predicted albedo
-// (default), their mean (--neural-materials node, models of format 4), or the whole asset's mean
+// plus a random two-point spread (default; --neural-materials fit without it), their mean
+// (--neural-materials node, models of format 4), or the whole asset's mean
 // (--neural-materials asset, models without per-node materials: asset_table.h asset_shading), transmission and
 // emission factors, unless the user overrides metallic/roughness (--neural-metallic,
 // --neural-roughness). Included by passes/shade.comp after lib/material.glsl.

@@ -94,11 +94,15 @@ TEST(CliExplain, ForcedCoopmatOnLavapipeIsTheRendersError) {
 
 } // namespace
 
-// A model of `nbvh train` (format 5) has node means and fits: fits by default, means on request.
+// A model of `nbvh train` (format 5) has node means and fits: fits and their spread by default, the fit
+// alone or the means on request.
 TEST(CliExplain, MaterialModesAreNamed) {
-    const auto fit = run_nbvh(explain({"--model", tiny_model().string()}), 60.0);
+    const auto mix = run_nbvh(explain({"--model", tiny_model().string()}), 60.0);
+    ASSERT_EQ(mix.exit_code, 0) << mix.describe();
+    EXPECT_TRUE(has(mix.out, "materials       per node, fit + spread (")) << mix.out;
+    const auto fit = run_nbvh(explain({"--model", tiny_model().string(), "--neural-materials", "fit"}), 60.0);
     ASSERT_EQ(fit.exit_code, 0) << fit.describe();
-    EXPECT_TRUE(has(fit.out, "materials       per node, fit (")) << fit.out;
+    EXPECT_TRUE(has(fit.out, "materials       per node, fit (--neural-materials fit")) << fit.out;
     const auto node = run_nbvh(explain({"--model", tiny_model().string(), "--neural-materials", "node"}), 60.0);
     ASSERT_EQ(node.exit_code, 0) << node.describe();
     EXPECT_TRUE(has(node.out, "materials       per node, mean (--neural-materials node)")) << node.out;
