@@ -41,9 +41,13 @@ NeuralModel make_neural_model(const TrainingAsset& asset, const TrainResult& res
                  100.0 * occupancy_fraction(m.tree(), m.occupancy, 0), m.occupancy.size() * 4 / 1024);
     }
     if (asset.mesh && asset.scene) {
+        const auto t0 = std::chrono::steady_clock::now();
         NodeMaterialTables t = build_node_materials(m.nodes, asset.bvh(), *asset.mesh, *asset.scene);
         m.node_materials = std::move(t.means);
         m.material_fits = std::move(t.fits);
+        log_info("node materials: %.0f ms (means and fits, %zu KiB)",
+                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count(),
+                 (m.node_materials.size() + m.material_fits.size()) * 4 / 1024);
     }
     TrainingMetadata& meta = m.meta;
     meta.steps = result.log.size();
