@@ -64,8 +64,8 @@ struct NeuralRenderOptions {
     // (shared/neural_occupancy.h; models without masks query every leaf). --neural-occupancy on|off.
     bool occupancy = true;
     // Metallic/roughness of a hit (engine/neural/node_materials.h): its N-BVH node's fit in the
-    // predicted albedo, the node's mean, or the asset's mean; a model without fits (format 4) falls
-    // back to its means, one without either to the asset's. --neural-materials fit|node|asset.
+    // predicted albedo (plus its random spread: mix), the node's mean, or the asset's mean; a model without fits (format 4) falls
+    // back to its means, one without either to the asset's. --neural-materials mix|fit|node|asset.
     NeuralMaterials materials = NeuralMaterials::mix;
     // A ray leaving a neural hit seen from behind (predicted normal along the incoming ray) skips
     // back-facing neural hits, so that it leaves the asset instead of bouncing inside it

@@ -159,7 +159,7 @@ struct GpuNeuralParams {
     // the same buffer, one word per node; 0 = none or off (hits take their asset's metallic/roughness).
     uint materials;
     // Per-node material fits (node_materials.h, nb_node_fit_eval): their first word in the same buffer,
-    // NB_NODE_FIT_WORDS per node; 0 = none or off (then `materials`). --neural-materials fit|node|asset.
+    // NB_NODE_FIT_WORDS per node; 0 = none or off (then `materials`). --neural-materials mix|fit|node|asset.
     uint material_fits;
     // 1: a hit's metallic/roughness also takes the fit's spread (nb_node_fit_spread), --neural-materials mix.
     uint material_spread;
