@@ -4,8 +4,9 @@
 # proxy leaves per mesh (median kd splits of the centroids, about the leaf count of a 10k-node model),
 # each triangle's metallic-roughness and base colour sampled at its centroid uv (nearest texel), and
 # the area-weighted RMS error (metallic and roughness together) of three predictors printed: the
-# asset's mean (nbvh before `57b84b1`), the leaf's mean (`--neural-materials node`, now) and a per-leaf
-# linear fit in the linear albedo (what the network predicts at a hit: 4 coefficients per output).
+# asset's mean (nbvh before `57b84b1`), the leaf's mean (`--neural-materials node`) and a per-leaf
+# linear fit in the linear albedo (what the network predicts at a hit: 4 coefficients per output; the
+# renderer's fits since `3e24e4c` add a ridge of 1e-3, engine/neural/node_materials.h).
 # Usage: /usr/bin/python3 scripts/bench/material_fit.py [SCENE.glb]   (numpy and PIL from Debian)
 import json, struct, io, sys
 import numpy as np
