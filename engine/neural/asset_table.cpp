@@ -127,7 +127,7 @@ glm::vec3 learned_albedo(const Scene& scene, const Material* material, glm::vec2
 }
 
 double triangle_material_points(const Scene& scene, const Mesh& m, const Material& material, uint32_t t,
-                                MaterialPoint points[MATERIAL_POINTS]) {
+                                MaterialPoint points[MATERIAL_POINTS], bool with_albedo) {
     if (3 * size_t(t) + 2 >= m.indices.size()) return 0.0;
     const uint32_t* idx = &m.indices[3 * size_t(t)];
     if (idx[0] >= m.positions.size() || idx[1] >= m.positions.size() || idx[2] >= m.positions.size()) return 0.0;
@@ -147,8 +147,11 @@ double triangle_material_points(const Scene& scene, const Mesh& m, const Materia
     for (uint32_t k = 0; k < MATERIAL_POINTS; ++k) {
         MaterialPoint& p = points[k];
         glm::vec2 uv(0.0f);
-        const bool has_uv = uv_of(material.base_color_tex.uv_set, BARY[k], uv);
-        p.albedo = learned_albedo(scene, &material, uv, has_uv);
+        p.albedo = glm::vec3(0.0f);
+        if (with_albedo) {
+            const bool has_uv = uv_of(material.base_color_tex.uv_set, BARY[k], uv);
+            p.albedo = learned_albedo(scene, &material, uv, has_uv);
+        }
         p.metallic = p.roughness = 1.0f;
         if (mr_texture && uv_of(mr.uv_set, BARY[k], uv)) {
             const glm::vec4 c = sample_texture_ref(scene.textures, mr, uv, false, glm::vec4(1.0f));
@@ -175,12 +178,12 @@ AssetShading asset_shading(const Scene& scene, uint32_t mesh) {
     double area = 0.0, metallic = 0.0, roughness = 0.0;
     MaterialPoint points[MATERIAL_POINTS];
     for (uint32_t t = 0; t < m.triangle_count(); ++t) {
-        const double a = triangle_material_points(scene, m, material, t, points);
+        const double a = triangle_material_points(scene, m, material, t, points, false);
         if (a <= 0.0) continue;
         double tm = 0.0, tr = 0.0; // per triangle first: the same sums as before the fits (bit for bit)
         for (const MaterialPoint& p : points) {
-            tm += a * 0.25 * double(p.metallic);
-            tr += a * 0.25 * double(p.roughness);
+            tm += a / MATERIAL_POINTS * double(p.metallic);
+            tr += a / MATERIAL_POINTS * double(p.roughness);
         }
         area += a;
         metallic += tm;

@@ -47,15 +47,16 @@ glm::vec3 learned_albedo(const Scene& scene, const Material* material, glm::vec2
 
 // One triangle of `mesh` (index `t`) seen at 4 fixed points (barycentric (1/3,1/3,1/3) and the three
 // (2/3,1/6,1/6) permutations): the learned albedo and the metallic-roughness texture's blue (metallic)
-// and green (roughness) channels, 1 without a texture (the factors are not applied). Returns the
-// triangle's area: 0, and `points` untouched, for a degenerate triangle or out-of-range indices.
+// and green (roughness) channels, 1 without a texture (the factors are not applied); `with_albedo` false
+// skips the albedo (left 0: the asset means need none). Returns the triangle's area: 0, and `points`
+// untouched, for a degenerate triangle or out-of-range indices.
 struct MaterialPoint {
     glm::vec3 albedo{0.0f};
     float metallic = 1.0f, roughness = 1.0f;
 };
 inline constexpr uint32_t MATERIAL_POINTS = 4;
 double triangle_material_points(const Scene& scene, const Mesh& mesh, const Material& material, uint32_t t,
-                                MaterialPoint points[MATERIAL_POINTS]);
+                                MaterialPoint points[MATERIAL_POINTS], bool with_albedo = true);
 
 // Binds a model to a scene: the model's assets decide which instances are neural (every instance of a
 // glTF mesh the model has an asset for), meshes are split by material, and every neural mesh must

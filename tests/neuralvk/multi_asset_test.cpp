@@ -348,6 +348,43 @@ TEST(MultiAsset, NodeMaterialsShadeTheHitsOfTheirLeaves) {
     }
 }
 
+// The spread reaches the shade pass (--neural-materials mix, the default): the pillar's fits made
+// metallic 0 +- 1 (clamped: metal or dielectric with a random sign per hit) and roughness 0.25 with no
+// spread, so its pixels converge to the mean of a metal render and a dielectric render (max depth 2: a
+// pixel sees its own surface only). The fit alone (--neural-materials fit) is the dielectric: the control.
+TEST(MultiAsset, MaterialSpreadMixesTheNodesMaterials) {
+    const Trained& t = trained();
+    NeuralModel model = t.model;
+    auto half2 = [](float lo, float hi) { return uint32_t(float_to_half_bits(lo)) | uint32_t(float_to_half_bits(hi)) << 16; };
+    const uint32_t fit[NB_NODE_FIT_WORDS] = {half2(0.0f, 0.0f), half2(0.0f, 0.0f), half2(0.25f, 0.0f), half2(0.0f, 0.0f),
+                                             half2(1.0f, 0.0f)};
+    std::vector<uint32_t> stack{model.assets[3].root};
+    ASSERT_EQ(model.assets[3].name, "pillar");
+    while (!stack.empty()) {
+        const uint32_t i = stack.back();
+        stack.pop_back();
+        for (uint32_t k = 0; k < NB_NODE_FIT_WORDS; ++k) model.material_fits[i * NB_NODE_FIT_WORDS + k] = fit[k];
+        if (model.nodes[i].has_children()) stack.insert(stack.end(), {model.nodes[i].left, model.nodes[i].left + 1});
+    }
+    LiveSetup s(model, SIZE, 9);
+    s.options.max_depth = 2;
+    s.options.spp = 16;
+    RenderOptions o = s.options;
+    const Image mix = convert_channels(s.fresh(o), 3);
+    o.neural.materials = render::NeuralMaterials::fit;
+    const Image fit_only = convert_channels(s.fresh(o), 3);
+    o.neural.roughness = 0.25f;
+    o.neural.metallic = 1.0f;
+    Image mean = convert_channels(s.fresh(o), 3);
+    o.neural.metallic = 0.0f;
+    const Image dielectric = convert_channels(s.fresh(o), 3);
+    for (size_t k = 0; k < mean.data.size(); ++k) mean.data[k] = 0.5f * (mean.data[k] + dielectric.data[k]);
+    const float err = flip_per_node(s.scene, mean, mix).at("pillar");
+    const float control = flip_per_node(s.scene, mean, fit_only).at("pillar");
+    std::printf("pillar: mix vs the mean of metal and dielectric FLIP %.4f, the fit alone %.4f\n", err, control);
+    EXPECT_LT(err, 0.5f * control);
+}
+
 TEST(MultiAsset, AModelForAnotherSceneIsRefusedNamingTheAsset) {
     const Trained& t = trained();
     auto expect_refused = [&](Scene s, const std::string& needle) {
