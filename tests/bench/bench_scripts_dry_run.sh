@@ -8,13 +8,13 @@ NBVH=$(realpath "$1") W=$2
 rm -rf "$W" && mkdir -p "$W"
 cd "$(dirname "$0")/../.."
 export NBVH TMPDIR=$W TRAIN_ARGS="--backend cpu --steps 20 --batch 256 --nodes 31 --hash-log2 10" WIDTH=32 HEIGHT=18 \
-  SPP=1 REPS=1 FLIP_W=32 FLIP_H=18 FLIP_SPP=2 SCENES=default VARIANTS=$'node|--neural-materials node\nfit|'
+  SPP=1 REPS=1 FLIP_W=32 FLIP_H=18 FLIP_SPP=2 SCENES=default VARIANTS=$'fit|--neural-materials fit\nmix|'
 scripts/bench/variant_flips.sh "$W/out" > "$W/log" 2>&1 || { cat "$W/log"; exit 1; }
 python3 - "$W/out" <<'PY'
 import json, math, re, sys
 out = sys.argv[1]
 rows = json.load(open(out + "/sweep/sweep.json"))["rows"]
-assert sorted(rows) == ["default_classical", "default_fit", "default_node"], sorted(rows)
+assert sorted(rows) == ["default_classical", "default_fit", "default_mix"], sorted(rows)
 for k, r in rows.items():
     assert math.isfinite(r["ms_per_spp"]) and r["ms_per_spp"] > 0, (k, r["ms_per_spp"])
 line = open(out + "/flips.txt").read()
