@@ -189,6 +189,20 @@ std::map<std::string, float> flip_per_node(const Scene& scene, const Image& ref,
     return out;
 }
 
+// Two fp16 in one word, `lo` in the low half (GLSL unpackHalf2x16 order).
+uint32_t half2(float lo, float hi) { return uint32_t(float_to_half_bits(lo)) | uint32_t(float_to_half_bits(hi)) << 16; }
+
+// Calls f(i) for every N-BVH node i of the subtree under `root` (an asset's nodes).
+template <class F> void for_each_subtree_node(const NeuralModel& model, uint32_t root, F f) {
+    std::vector<uint32_t> stack{root};
+    while (!stack.empty()) {
+        const uint32_t i = stack.back();
+        stack.pop_back();
+        f(i);
+        if (model.nodes[i].has_children()) stack.insert(stack.end(), {model.nodes[i].left, model.nodes[i].left + 1});
+    }
+}
+
 // The live-update tests' setting: the test scene bound to the trained model, a lavapipe context with
 // validation, its BVHs, small scalar-path options of the model, and a fresh renderer's image for options.
 struct LiveSetup {
@@ -302,16 +316,11 @@ TEST(MultiAsset, NodeMaterialsShadeTheHitsOfTheirLeaves) {
     ASSERT_EQ(model.material_fits.size(), model.nodes.size() * NB_NODE_FIT_WORDS);
     const uint32_t pillar = 3;
     ASSERT_EQ(model.assets[pillar].name, "pillar");
-    auto half2 = [](float lo, float hi) { return uint32_t(float_to_half_bits(lo)) | uint32_t(float_to_half_bits(hi)) << 16; };
     const uint32_t fit[NB_NODE_FIT_WORDS] = {half2(0.0f, 4.0f), half2(4.0f, 4.0f), half2(0.25f, 0.0f), half2(0.0f, 0.0f)};
-    std::vector<uint32_t> stack{model.assets[pillar].root};
-    while (!stack.empty()) {
-        const uint32_t i = stack.back();
-        stack.pop_back();
+    for_each_subtree_node(model, model.assets[pillar].root, [&](uint32_t i) {
         model.node_materials[i] = nb_pack_node_material(1.0f, 0.25f);
         for (uint32_t k = 0; k < NB_NODE_FIT_WORDS; ++k) model.material_fits[i * NB_NODE_FIT_WORDS + k] = fit[k];
-        if (model.nodes[i].has_children()) stack.insert(stack.end(), {model.nodes[i].left, model.nodes[i].left + 1});
-    }
+    });
     LiveSetup s(model, SIZE, 5);
     s.options.max_depth = 2;
     s.options.spp = 4;
@@ -355,17 +364,12 @@ TEST(MultiAsset, NodeMaterialsShadeTheHitsOfTheirLeaves) {
 TEST(MultiAsset, MaterialSpreadMixesTheNodesMaterials) {
     const Trained& t = trained();
     NeuralModel model = t.model;
-    auto half2 = [](float lo, float hi) { return uint32_t(float_to_half_bits(lo)) | uint32_t(float_to_half_bits(hi)) << 16; };
     const uint32_t fit[NB_NODE_FIT_WORDS] = {half2(0.0f, 0.0f), half2(0.0f, 0.0f), half2(0.25f, 0.0f), half2(0.0f, 0.0f),
                                              half2(1.0f, 0.0f)};
-    std::vector<uint32_t> stack{model.assets[3].root};
     ASSERT_EQ(model.assets[3].name, "pillar");
-    while (!stack.empty()) {
-        const uint32_t i = stack.back();
-        stack.pop_back();
+    for_each_subtree_node(model, model.assets[3].root, [&](uint32_t i) {
         for (uint32_t k = 0; k < NB_NODE_FIT_WORDS; ++k) model.material_fits[i * NB_NODE_FIT_WORDS + k] = fit[k];
-        if (model.nodes[i].has_children()) stack.insert(stack.end(), {model.nodes[i].left, model.nodes[i].left + 1});
-    }
+    });
     LiveSetup s(model, SIZE, 9);
     s.options.max_depth = 2;
     s.options.spp = 16;
