@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <nlohmann/json.hpp>
 
 #include "tests/cli/run_nbvh.h"
@@ -57,7 +58,9 @@ std::vector<std::string> tiny_args(const fs::path& out, const std::string& nodes
 const Study& tiny_study() {
     static const Study s = [] {
         Study st;
-        st.dir = nbvh::test::temp_dir("study_tiny") / "out";
+        // One directory per process: ctest runs each TEST of this file as its own process, two of them
+        // (this sweep's users) at once under -j2, and temp_dir empties the directory it returns.
+        st.dir = nbvh::test::temp_dir("study_tiny_" + std::to_string(::getpid())) / "out";
         setenv("NBVH_VALIDATION", "1", 1); // the child runs with the validation layer; any message fails
         st.run = run_nbvh(tiny_args(st.dir, "31,63"), 500.0);
         unsetenv("NBVH_VALIDATION");
