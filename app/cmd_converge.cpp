@@ -192,6 +192,7 @@ void run_converge(const ConvergeArgs& a) {
         {"lod", a.lod},
         {"secondary_lod", a.secondary_lod},
         {"neural_path", neural_path},
+        {"sampler", render::sampler_name(base.sampler)},
         {"seed", base.seed},
         {"reference_seed", ref_opt.seed},
         {"ref_spp", ref_spp},

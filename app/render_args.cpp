@@ -12,6 +12,19 @@
 
 namespace nbvh::app {
 
+namespace {
+
+// --sampler sobol|random (render::sampler_name is the flag's word).
+void add_sampler_flag(CLI::App* cmd, render::Sampler& sampler) {
+    cmd->add_option_function<std::string>(
+           "--sampler", [&sampler](const std::string& v) { sampler = v == "random" ? render::Sampler::random : render::Sampler::sobol; },
+           "the paths' random numbers: Owen-scrambled Sobol points per pixel (sobol, default: less noise at the "
+           "same spp) or independent numbers (random)")
+        ->check(CLI::IsMember({"sobol", "random"}));
+}
+
+} // namespace
+
 void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
     cmd->add_option("--width", o.width, "image width in pixels")->check(CLI::Range(1u, 16384u));
     cmd->add_option("--height", o.height, "image height in pixels")->check(CLI::Range(1u, 16384u));
@@ -55,6 +68,7 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
            "trace secondary and shadow rays grouped by direction and origin (on, default) "
            "or in queue order (off); same image")
         ->check(CLI::IsMember({"on", "off"}));
+    add_sampler_flag(cmd, o.sampler);
     cmd->add_option("--wave-pixels", o.max_wave_pixels,
                     "paths traced per wave (rays per queue; several samples of each pixel while they fit in 32M paths, "
                     "up to 16; also bounded by the device's buffer, memory and dispatch limits)")

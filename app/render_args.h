@@ -13,7 +13,7 @@
 
 namespace nbvh::app {
 
-// Adds --width --height --spp --max-depth --seed --wave-pixels and the neural material/round flags
+// Adds --width --height --spp --max-depth --seed --wave-pixels --sampler and the neural material/round flags
 // (--neural-roughness --neural-metallic --neural-max-leaves --neural-batched-rounds
 // --neural-leaves-per-round), writing into `o`
 // (which must outlive the parse).

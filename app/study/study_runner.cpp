@@ -123,6 +123,7 @@ void StudyRun::write_results() const {
           {"cap_study", o_.cap_study},
           {"leaves_per_round", o_.render.neural.leaves_per_round},
           {"neural_path", render::neural_path_name(neural_path_)},
+          {"sampler", render::sampler_name(o_.render.sampler)},
           {"neural_kernel", kernel_},
           {"lods", o_.lods},
           {"exposure", o_.exposure},

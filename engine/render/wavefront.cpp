@@ -121,6 +121,7 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     p.ray_epsilon = NB_RAY_EPSILON_SCALE * data_.scene_extent;
     p.instance_count = accel.tlas.prim_indices.empty() ? 0u : uint32_t(data_.instances.size());
     p.sort_rays = options_.sort_rays ? 1u : 0u;
+    p.path_sampler = options_.sampler == Sampler::sobol ? NB_SAMPLER_SOBOL : NB_SAMPLER_RANDOM;
 
     // Buffers, indexed by binding.
     buffers_.resize(NB_BINDING_COUNT);
@@ -272,6 +273,8 @@ bool WavefrontRenderer::apply(const RenderOptions& o) {
     params_.spp = o.spp;
     options_.sort_rays = o.sort_rays;
     params_.sort_rays = o.sort_rays ? 1u : 0u;
+    options_.sampler = o.sampler;
+    params_.path_sampler = o.sampler == Sampler::sobol ? NB_SAMPLER_SOBOL : NB_SAMPLER_RANDOM;
     buffers_[NB_BIND_PARAMS].upload(&params_, sizeof(params_));
     if (neural_) {
         options_.neural = n;

@@ -26,6 +26,10 @@
 
 namespace nbvh::render {
 
+// The paths' random numbers (RenderOptions::sampler).
+enum class Sampler { sobol, random };
+inline const char* sampler_name(Sampler s) { return s == Sampler::random ? "random" : "sobol"; }
+
 struct RenderOptions {
     uint32_t width = 640, height = 480;
     uint32_t spp = 16;
@@ -43,6 +47,9 @@ struct RenderOptions {
     // wavefront_gpu.h NB_RS_*, passes/ray_sort.comp; the hybrid's neural traversal op 0 too): same image,
     // coherent warps. --sort-rays.
     bool sort_rays = true;
+    // The paths' random numbers (lib/path_sampler.glsl): Owen-scrambled Sobol pairs per pixel (default;
+    // lower variance at the same spp) or independent PCG numbers. --sampler.
+    Sampler sampler = Sampler::sobol;
     NeuralRenderOptions neural;      // hybrid (model) or classical-reference render of neural instances
     // Texel buffer or sampled-image array (texture_path.h): auto takes the array where the device can.
     TexturePathRequest texture_path = TexturePathRequest::automatic;

@@ -6,7 +6,8 @@
 # Usage (after `source .device/env.sh`): scripts/bench/converge.sh OUT [default] [dragon] [chess]
 # Env: NBVH (binary, default .device/study/bin/nbvh, xz-packed allowed), FROM (128), SPP (8192),
 #      REF_SPP (32768), WIDTH x HEIGHT (960 x 540), BACKEND (cuda), DEVICE (gpu), TRAIN_ARGS (extra nbvh
-#      train flags). Writes OUT/SCENE.json, OUT/SCENE.csv and OUT/log.txt (the tables).
+#      train flags), SAMPLERS (sobol; e.g. "sobol random": one model, one run per --sampler). Writes
+#      OUT/SCENE.json and OUT/SCENE.csv (OUT/SCENE_random.* for --sampler random) and OUT/log.txt.
 # A dry run on the build machine: BACKEND=cpu DEVICE=cpu WIDTH=32 HEIGHT=18 FROM=1 SPP=2 REF_SPP=4
 #      TRAIN_ARGS="--steps 20 --batch 256 --nodes 63" NBVH=build/app/nbvh scripts/bench/converge.sh OUT default
 # Measured on the H100 (2026-11-26, results/study/convergence/log.txt): 124 + 151 + 90 = 365 s for the three scenes.
@@ -47,10 +48,15 @@ fi
     # shellcheck disable=SC2086
     "$NBVH" train "${SCENE[@]}" "${NEURAL[@]}" --backend "${BACKEND:-cuda}" ${TRAIN_ARGS:-} --out "$TMP/$WHICH.nbvh" 2>&1 \
       | grep -v "^step " | tail -3
-    "$NBVH" converge "${SCENE[@]}" --model "$TMP/$WHICH.nbvh" "${VIEW[@]}" --device "${DEVICE:-gpu}" \
-      --width "${WIDTH:-960}" --height "${HEIGHT:-540}" \
-      --max-depth 8 --from "${FROM:-128}" --spp "${SPP:-8192}" --ref-spp "${REF_SPP:-32768}" \
-      --json "$OUT/$WHICH.json" --csv "$OUT/$WHICH.csv"
+    for SAMPLER in ${SAMPLERS:-sobol}; do
+      NAME=$WHICH
+      [ "$SAMPLER" = sobol ] || NAME=${WHICH}_$SAMPLER
+      echo "-- --sampler $SAMPLER"
+      "$NBVH" converge "${SCENE[@]}" --model "$TMP/$WHICH.nbvh" "${VIEW[@]}" --device "${DEVICE:-gpu}" \
+        --width "${WIDTH:-960}" --height "${HEIGHT:-540}" --sampler "$SAMPLER" \
+        --max-depth 8 --from "${FROM:-128}" --spp "${SPP:-8192}" --ref-spp "${REF_SPP:-32768}" \
+        --json "$OUT/$NAME.json" --csv "$OUT/$NAME.csv"
+    done
     echo "$WHICH: $(( $(date +%s) - t0 )) s"
   done
 } 2>&1 | tee "$OUT/log.txt"

@@ -56,9 +56,9 @@ uint nb_env_search(uint base, uint n, float u) {
 }
 
 // Samples a direction; returns the radiance and solid-angle pdf (0 when the sample is unusable).
-vec3 nb_env_sample(inout uint rng, out vec3 dir, out float pdf) {
-    float u1 = nb_rng_next(rng);
-    float u2 = nb_rng_next(rng);
+vec3 nb_env_sample(vec2 u, out vec3 dir, out float pdf) {
+    float u1 = u.x;
+    float u2 = u.y;
     uint mb = nb_env_marginal_base();
     uint y = nb_env_search(mb, params.env_height, u1);
     float c0 = env_data[mb + y], c1 = env_data[mb + y + 1u];

@@ -42,10 +42,10 @@ void nb_light_strategies(out float p_env, out float p_emissive, out float p_punc
 
 // Samples a point on an emissive triangle as seen from p. Returns its radiance towards p; wi, dist
 // and the solid-angle pdf (0: unusable sample).
-vec3 nb_emissive_sample(vec3 p, inout uint rng, out vec3 wi, out float dist, out float pdf) {
-    float u0 = nb_rng_next(rng);
-    float u1 = nb_rng_next(rng);
-    float u2 = nb_rng_next(rng);
+// u0 picks the triangle (power cdf), u the point on it.
+vec3 nb_emissive_sample(vec3 p, float u0, vec2 u, out vec3 wi, out float dist, out float pdf) {
+    float u1 = u.x;
+    float u2 = u.y;
     pdf = 0.0f;
     dist = 0.0f;
     wi = vec3(0.0f, 0.0f, 1.0f);
@@ -77,8 +77,7 @@ vec3 nb_emissive_sample(vec3 p, inout uint rng, out vec3 wi, out float dist, out
 // radiance is f(wo, wi) cos(theta_i) Le / pdf (point/spot: colour x intensity / d^2 x cone x range window;
 // directional: colour x illuminance); wi, dist (NB_INF: directional) and pdf, the discrete probability of
 // choosing this light (0: unusable sample). Range window and cone: KHR_lights_punctual's recommended ones.
-vec3 nb_punctual_sample(vec3 p, inout uint rng, out vec3 wi, out float dist, out float pdf) {
-    float u = nb_rng_next(rng);
+vec3 nb_punctual_sample(vec3 p, float u, out vec3 wi, out float dist, out float pdf) {
     pdf = 0.0f;
     dist = NB_INF;
     wi = vec3(0.0f, 0.0f, 1.0f);

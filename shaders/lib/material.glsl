@@ -121,11 +121,10 @@ vec3 nb_bsdf_eval(Surface s, vec3 wo, vec3 wi, out float pdf) {
 }
 
 // Samples a continuation direction. weight = f cos / pdf; pdf < 0 marks the delta transmission lobe.
-// Returns false when the path ends (sample below the surface).
-bool nb_bsdf_sample(Surface s, vec3 wo, inout uint rng, out vec3 wi, out vec3 weight, out float pdf) {
-    float u0 = nb_rng_next(rng);
-    float u1 = nb_rng_next(rng);
-    float u2 = nb_rng_next(rng);
+// u0 picks the lobe, (u1, u2) the direction. Returns false when the path ends (sample below the surface).
+bool nb_bsdf_sample(Surface s, vec3 wo, float u0, vec2 u, out vec3 wi, out vec3 weight, out float pdf) {
+    float u1 = u.x;
+    float u2 = u.y;
     weight = vec3(0.0f);
     pdf = 0.0f;
     wi = s.n;

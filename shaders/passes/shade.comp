@@ -12,6 +12,7 @@
 #include "lib/env.glsl"
 #include "lib/lights.glsl"
 #include "lib/neural_surface.glsl"
+#include "lib/path_sampler.glsl"
 #include "shared/intersect.h"
 
 layout(local_size_x = NB_WAVEFRONT_GROUP) in;
@@ -27,7 +28,7 @@ void main() {
     vec3 throughput = ray_load3(q, NB_RAY_THROUGHPUT, i);
     uint slot = ray_load1(q, NB_RAY_PIXEL, i);
     uint depth = ray_load1(q, NB_RAY_DEPTH, i) & ~NB_RAY_BACKFACE_BIT;
-    uint rng = ray_load1(q, NB_RAY_RNG, i);
+    PathSampler ps = nb_path_sampler(slot, depth, ray_load1(q, NB_RAY_RNG, i));
     float prev_pdf = uintBitsToFloat(ray_load1(q, NB_RAY_PDF, i));
     float p_env, p_emissive, p_punctual;
     nb_light_strategies(p_env, p_emissive, p_punctual);
@@ -43,7 +44,7 @@ void main() {
     }
     float t = uintBitsToFloat(hit_load1(NB_HIT_T, i));
     uint tri_index = hit_load1(NB_HIT_TRIANGLE, i);
-    Surface s = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE) ? nb_make_neural_surface(i, org, dir, t, nb_pcg_hash(rng ^ 0xA511E9B3u))
+    Surface s = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE) ? nb_make_neural_surface(i, org, dir, t, uint(2.0f * nb_path_2d(ps, NB_PAIR_MATERIAL).x))
                                                                    : nb_make_surface(instance, tri_index, hit_load_bary(i), org, dir, t);
     vec3 wo = -dir;
 
@@ -66,15 +67,17 @@ void main() {
         float light_pdf = 0.0f, dist = NB_INF;
         vec3 le = vec3(0.0f);
         bool delta = false; // punctual: light_pdf is a discrete probability, no MIS
-        float u = nb_rng_next(rng);
+        vec2 pick = nb_path_2d(ps, NB_PAIR_LIGHT_PICK);
+        vec2 ul = nb_path_2d(ps, NB_PAIR_LIGHT);
+        float u = pick.x;
         if (NB_HAS_ENVIRONMENT && u < p_env) {
-            le = nb_env_sample(rng, wi, light_pdf);
+            le = nb_env_sample(ul, wi, light_pdf);
             light_pdf *= p_env;
         } else if (NB_HAS_EMISSION && p_emissive > 0.0f && u < p_env + p_emissive) {
-            le = nb_emissive_sample(s.p, rng, wi, dist, light_pdf);
+            le = nb_emissive_sample(s.p, pick.y, ul, wi, dist, light_pdf);
             light_pdf *= p_emissive;
         } else if (NB_HAS_PUNCTUAL && p_punctual > 0.0f) {
-            le = nb_punctual_sample(s.p, rng, wi, dist, light_pdf);
+            le = nb_punctual_sample(s.p, pick.y, wi, dist, light_pdf);
             light_pdf *= p_punctual;
             delta = true;
         }
@@ -101,11 +104,12 @@ void main() {
     // Continuation.
     vec3 wi, weight;
     float pdf;
-    if (!nb_bsdf_sample(s, wo, rng, wi, weight, pdf)) return;
+    vec2 lobe = nb_path_2d(ps, NB_PAIR_LOBE);
+    if (!nb_bsdf_sample(s, wo, lobe.x, nb_path_2d(ps, NB_PAIR_BSDF), wi, weight, pdf)) return;
     throughput *= weight;
     if (depth + 1u >= params.rr_start_depth) {
         float survive = min(1.0f, max(throughput.x, max(throughput.y, throughput.z)));
-        if (!(nb_rng_next(rng) < survive)) return;
+        if (!(lobe.y < survive)) return;
         throughput /= survive;
     }
     if (!(max(throughput.x, max(throughput.y, throughput.z)) > 0.0f)) return;
@@ -121,7 +125,7 @@ void main() {
     ray_store3(out_q, NB_RAY_THROUGHPUT, k, throughput);
     ray_store1(out_q, NB_RAY_PIXEL, k, slot);
     ray_store1(out_q, NB_RAY_DEPTH, k, (depth + 1u) | escape);
-    ray_store1(out_q, NB_RAY_RNG, k, rng);
+    ray_store1(out_q, NB_RAY_RNG, k, nb_path_next_rng(ps));
     ray_store1(out_q, NB_RAY_PDF, k, floatBitsToUint(pdf));
     ray_store1(out_q, NB_RAY_T_RESUME, k, floatBitsToUint(0.0f));
 }

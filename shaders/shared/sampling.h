@@ -34,6 +34,67 @@ NB_FN float nb_rng_next(NB_INOUT(uint) state) {
     return float(word >> 8u) * (1.0f / 16777216.0f);
 }
 
+// ---- Quasi-random numbers: shuffled, Owen-scrambled Sobol (Burley 2020, "Practical Hash-based Owen
+// Scrambling", JCGT 9(4)) ------------------------------------------------------------------------------
+// Each 2D sample dimension pair of a path (pixel jitter, a bounce's light sample, its BSDF sample, ...)
+// takes the first two Sobol dimensions (a (0,2)-sequence), its index shuffled and its values scrambled
+// by nested uniform (Owen) scrambling seeded per pixel and dimension: every power-of-two prefix of a
+// pixel's samples is a stratified (0,m,2)-net in each pair, and the pairs are independent ("padding").
+// Unbiased like independent samples; the variance of smooth integrands falls faster than 1/spp.
+#ifdef NB_GLSL
+#define nb_reverse_bits(x) bitfieldReverse(x)
+#else
+NB_FN uint nb_reverse_bits(uint x) {
+    x = ((x >> 1u) & 0x55555555u) | ((x & 0x55555555u) << 1u);
+    x = ((x >> 2u) & 0x33333333u) | ((x & 0x33333333u) << 2u);
+    x = ((x >> 4u) & 0x0F0F0F0Fu) | ((x & 0x0F0F0F0Fu) << 4u);
+    x = ((x >> 8u) & 0x00FF00FFu) | ((x & 0x00FF00FFu) << 8u);
+    return (x >> 16u) | (x << 16u);
+}
+#endif
+
+// Burley's improved Laine-Karras permutation: bit j of the result depends only on bits <= j of x.
+NB_FN uint nb_laine_karras(uint x, uint seed) {
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return x;
+}
+
+// Nested uniform scramble of a 0.32 fixed-point value (bit 31 = 1/2): bit j flips as a function of
+// the bits above it only.
+NB_FN uint nb_owen_scramble(uint x, uint seed) {
+    return nb_reverse_bits(nb_laine_karras(nb_reverse_bits(x), seed));
+}
+
+// Sobol dimension 1 (generator matrix: Pascal's triangle mod 2) in 0.32 fixed point; dimension 0 is
+// the van der Corput sequence, nb_reverse_bits(i).
+NB_FN uint nb_sobol_dim1(uint i) {
+    uint r = 0u;
+    for (uint v = 0x80000000u; i != 0u; i >>= 1u, v ^= v >> 1u) {
+        if ((i & 1u) != 0u) r ^= v;
+    }
+    return r;
+}
+
+// Seed of one sample dimension pair of one path: pixel seed (nb_qmc_pixel_seed), segment and pair.
+NB_FN uint nb_qmc_pixel_seed(uint pixel, uint seed) {
+    return nb_pcg_hash(pixel ^ nb_pcg_hash(seed + 0x7F4A7C15u));
+}
+NB_FN uint nb_qmc_dim_seed(uint pixel_seed, uint depth, uint pair) {
+    return nb_pcg_hash(pixel_seed ^ nb_pcg_hash((depth << 4u) + pair));
+}
+
+// Point sample_index of the shuffled, scrambled 2D sequence of a dimension seed; in [0, 1)^2, 24 bits.
+NB_FN vec2 nb_qmc_2d(uint sample_index, uint dim_seed) {
+    uint i = nb_owen_scramble(sample_index, dim_seed);
+    uint x = nb_owen_scramble(nb_reverse_bits(i), nb_pcg_hash(dim_seed ^ 0xA3C59AC3u));
+    uint y = nb_owen_scramble(nb_sobol_dim1(i), nb_pcg_hash(dim_seed ^ 0x3C6EF372u));
+    return vec2(float(x >> 8u), float(y >> 8u)) * (1.0f / 16777216.0f);
+}
+
 // ---- Helpers --------------------------------------------------------------------------------------
 NB_FN float nb_luminance(vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 

@@ -144,8 +144,14 @@ struct GpuFrameParams {
     uint punctual_count;   // KHR_lights_punctual lights after the emissive triangles in the light array;
                            // their power cdf follows the emissive one in light_cdf (at light_count + 1)
     uint sort_rays;        // 1: shade.comp counts the rays it appends into the ray-sort bins (NB_RS_*)
+    uint path_sampler;     // NB_SAMPLER_*: the path's random numbers (lib/path_sampler.glsl)
+    uint pad0;
+    uint pad1;
+    uint pad2;
 };
-NB_STATIC_ASSERT(sizeof(GpuFrameParams) == 128, "GpuFrameParams layout");
+NB_STATIC_ASSERT(sizeof(GpuFrameParams) == 144, "GpuFrameParams layout");
+#define NB_SAMPLER_RANDOM 0u // independent PCG numbers per path
+#define NB_SAMPLER_SOBOL 1u  // Owen-scrambled Sobol pairs per pixel (shared/sampling.h nb_qmc_2d)
 
 // ---- Descriptor set 0 bindings (one layout shared by every pass) --------------------------------
 #define NB_BIND_PARAMS 0u

@@ -1,0 +1,47 @@
+// The random numbers of one path segment (camera_rays.comp, shade.comp). Each decision of a segment
+// has its own 2D dimension pair (NB_PAIR_*), so with --sampler sobol (params.path_sampler ==
+// NB_SAMPLER_SOBOL, the default) every pair is an Owen-scrambled Sobol net over the pixel's samples
+// (shared/sampling.h nb_qmc_2d), seeded by pixel, --seed, segment and pair: nothing is carried between
+// segments. --sampler random draws the same decisions from the path's PCG state (NB_RAY_RNG), as
+// before the Sobol sampler. Either way NB_RAY_RNG advances once per segment: it seeds stochastic alpha.
+#ifndef NB_PATH_SAMPLER_GLSL
+#define NB_PATH_SAMPLER_GLSL
+#include "lib/bindings.glsl"
+#include "shared/sampling.h"
+
+#define NB_PAIR_CAMERA 0u      // segment 0: pixel jitter (x, y)
+#define NB_PAIR_LIGHT_PICK 1u  // x: light strategy, y: which light of it
+#define NB_PAIR_LIGHT 2u       // the point or direction on the light
+#define NB_PAIR_LOBE 3u        // x: BSDF lobe, y: Russian roulette
+#define NB_PAIR_BSDF 4u        // the BSDF direction
+#define NB_PAIR_MATERIAL 5u    // x: the neural surface's material spread sign
+
+struct PathSampler {
+    uint rng;         // PCG state (--sampler random), NB_RAY_RNG
+    uint pixel_seed;  // nb_qmc_pixel_seed
+    uint sample_index;
+    uint depth;
+};
+
+// The sampler of the path in wave slot `slot` at segment `depth`, PCG state `rng`.
+PathSampler nb_path_sampler(uint slot, uint depth, uint rng) {
+    PathSampler ps;
+    ps.rng = rng;
+    ps.pixel_seed = nb_qmc_pixel_seed(nb_slot_pixel(slot, pc.pixel_offset, pc.pixel_count), params.seed);
+    ps.sample_index = nb_slot_sample(slot, pc.sample_index, pc.pixel_count);
+    ps.depth = depth;
+    return ps;
+}
+
+vec2 nb_path_2d(inout PathSampler ps, uint pair) {
+    if (params.path_sampler == NB_SAMPLER_SOBOL)
+        return nb_qmc_2d(ps.sample_index, nb_qmc_dim_seed(ps.pixel_seed, ps.depth, pair));
+    float u1 = nb_rng_next(ps.rng);
+    float u2 = nb_rng_next(ps.rng);
+    return vec2(u1, u2);
+}
+
+// NB_RAY_RNG for the path's next segment.
+uint nb_path_next_rng(PathSampler ps) { return nb_pcg_hash(ps.rng ^ 0x2545F491u); }
+
+#endif
