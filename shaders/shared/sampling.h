@@ -69,15 +69,19 @@ NB_FN uint nb_owen_scramble(uint x, uint seed) {
     return nb_reverse_bits(nb_laine_karras(nb_reverse_bits(x), seed));
 }
 
-// Sobol dimension 1 (generator matrix: Pascal's triangle mod 2) in 0.32 fixed point; dimension 0 is
-// the van der Corput sequence, nb_reverse_bits(i).
-NB_FN uint nb_sobol_dim1(uint i) {
-    uint r = 0u;
-    for (uint v = 0x80000000u; i != 0u; i >>= 1u, v ^= v >> 1u) {
-        if ((i & 1u) != 0u) r ^= v;
-    }
-    return r;
+// Sobol dimension 1 in 0.32 fixed point; dimension 0 is the van der Corput sequence, nb_reverse_bits(i).
+// Its generator matrix is Pascal's triangle mod 2: digit r of the result (bit 31 - r) is the XOR of the
+// index bits c with C(c, r) odd, i.e. (Lucas) with r a bit-subset of c. That superset XOR over the 5-bit
+// positions is one butterfly per position bit (a GF(2) zeta transform): no loop over the index bits.
+NB_FN uint nb_sobol_dim1_digits(uint i) {
+    i ^= (i >> 1u) & 0x55555555u;
+    i ^= (i >> 2u) & 0x33333333u;
+    i ^= (i >> 4u) & 0x0F0F0F0Fu;
+    i ^= (i >> 8u) & 0x00FF00FFu;
+    i ^= (i >> 16u) & 0x0000FFFFu;
+    return i; // digit r at bit r
 }
+NB_FN uint nb_sobol_dim1(uint i) { return nb_reverse_bits(nb_sobol_dim1_digits(i)); }
 
 // Seed of one sample dimension pair of one path: pixel seed (nb_qmc_pixel_seed), segment and pair.
 NB_FN uint nb_qmc_pixel_seed(uint pixel, uint seed) {
@@ -88,10 +92,12 @@ NB_FN uint nb_qmc_dim_seed(uint pixel_seed, uint depth, uint pair) {
 }
 
 // Point sample_index of the shuffled, scrambled 2D sequence of a dimension seed; in [0, 1)^2, 24 bits.
+// nb_owen_scramble(nb_reverse_bits(i)) and nb_owen_scramble(nb_sobol_dim1(i)) with the reversals that
+// cancel left out.
 NB_FN vec2 nb_qmc_2d(uint sample_index, uint dim_seed) {
     uint i = nb_owen_scramble(sample_index, dim_seed);
-    uint x = nb_owen_scramble(nb_reverse_bits(i), nb_pcg_hash(dim_seed ^ 0xA3C59AC3u));
-    uint y = nb_owen_scramble(nb_sobol_dim1(i), nb_pcg_hash(dim_seed ^ 0x3C6EF372u));
+    uint x = nb_reverse_bits(nb_laine_karras(i, nb_pcg_hash(dim_seed ^ 0xA3C59AC3u)));
+    uint y = nb_reverse_bits(nb_laine_karras(nb_sobol_dim1_digits(i), nb_pcg_hash(dim_seed ^ 0x3C6EF372u)));
     return vec2(float(x >> 8u), float(y >> 8u)) * (1.0f / 16777216.0f);
 }
 

@@ -21,8 +21,18 @@ TEST(QmcSampler, SobolDimensionsAreTheReferenceOnes) {
         EXPECT_EQ(double(nb_sobol_dim1(i)) / 4294967296.0, d1[i]) << i;
     }
     EXPECT_EQ(nb_reverse_bits(0x12345678u), 0x1E6A2C48u);
-    // All 32 direction numbers have their top bit set: an even count of them, so the top bit is 0.
-    EXPECT_EQ(nb_sobol_dim1(0xFFFFFFFFu) >> 31, 0u);
+    // The butterfly form against the textbook one: XOR of the direction numbers v_1 = 1/2,
+    // v_{k+1} = v_k ^ (v_k >> 1) of the index's set bits.
+    for (uint i : {9u, 255u, 256u, 0x12345678u, 0x80000001u, 0xFFFFFFFFu}) {
+        uint r = 0u, v = 0x80000000u;
+        for (uint j = i; j != 0u; j >>= 1u, v ^= v >> 1u) r ^= (j & 1u) ? v : 0u;
+        EXPECT_EQ(nb_sobol_dim1(i), r) << i;
+    }
+    // nb_qmc_2d is the scrambled pair of the shuffled index (the reversals that cancel left out).
+    const uint seed = 4242u, i = nb_owen_scramble(37u, seed);
+    const vec2 u = nb_qmc_2d(37u, seed);
+    EXPECT_EQ(uint(double(u.x) * 16777216.0), nb_owen_scramble(nb_reverse_bits(i), nb_pcg_hash(seed ^ 0xA3C59AC3u)) >> 8);
+    EXPECT_EQ(uint(double(u.y) * 16777216.0), nb_owen_scramble(nb_sobol_dim1(i), nb_pcg_hash(seed ^ 0x3C6EF372u)) >> 8);
 }
 
 TEST(QmcSampler, OwenScrambleKeepsTheHigherBitsPrefix) {
