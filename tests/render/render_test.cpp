@@ -27,7 +27,7 @@ struct Rendered {
 
 Rendered render_small(const Scene& scene, const Environment& env, uint32_t spp = 4, uint32_t max_depth = 3,
                       uint32_t seed = 1, uint32_t width = 48, uint32_t height = 32, uint32_t wave_pixels = 1024,
-                      bool sort_rays = RenderOptions{}.sort_rays) {
+                      bool sort_rays = RenderOptions{}.sort_rays, Sampler sampler = RenderOptions{}.sampler) {
     vk::ContextOptions o;
     o.device = vk::DeviceChoice::cpu;
     o.validation = true;
@@ -41,6 +41,7 @@ Rendered render_small(const Scene& scene, const Environment& env, uint32_t spp =
     opt.seed = seed;
     opt.max_wave_pixels = wave_pixels; // 1024 at 48x32: two waves, exercises the wave offsets
     opt.sort_rays = sort_rays;
+    opt.sampler = sampler;
     const Camera cam = scene.has_camera ? scene.camera : auto_frame(scene, 1.5f);
     WavefrontRenderer r(ctx, scene, accel, env, cam, opt);
     Rendered out;
@@ -177,6 +178,45 @@ TEST(Render, SortedRaysKeepTheImage) {
         EXPECT_EQ(plain.result.stats.rays_shadow, sorted.result.stats.rays_shadow);
         EXPECT_EQ(plain.result.image.data, sorted.result.image.data) << "wave pixels " << wave_pixels;
     }
+}
+
+// The Sobol sampler (lib/path_sampler.glsl) against independent numbers on a scene with every sampled
+// decision (environment and emissive-triangle NEE, textured GGX and Lambert lobes, Russian roulette from
+// segment 3, stochastic alpha): both estimate the same image (means agree, a 1024-spp Sobol render
+// matches an independent one to its noise), and at 32 spp Sobol's error against the 1024-spp
+// independent reference is lower (measured: RMSE 0.0151 vs 0.0336, 0.45x). A dimension shared by two decisions
+// or a pair reused across segments biases the mean or raises the error.
+TEST(Render, SobolSamplerIsUnbiasedAndLessNoisy) {
+    Scene s = test::make_textured_scene();
+    const Environment env = constant_environment(glm::vec3(0.6f, 0.7f, 0.8f));
+    const uint32_t w = 24, h = 16, depth = 5;
+    auto render = [&](uint32_t spp, uint32_t seed, Sampler sampler) {
+        return render_small(s, env, spp, depth, seed, w, h, 1u << 22, true, sampler);
+    };
+    const Rendered ref = render(1024, 100, Sampler::random);
+    const Rendered sobol_ref = render(1024, 101, Sampler::sobol);
+    expect_sane(ref);
+    expect_sane(sobol_ref);
+    auto mean = [](const Image& img) {
+        double m = 0.0;
+        for (size_t i = 0; i < img.pixel_count(); ++i) m += img.data[i * 4] + img.data[i * 4 + 1] + img.data[i * 4 + 2];
+        return m / double(img.pixel_count());
+    };
+    auto rmse = [&](const Image& a, const Image& b) {
+        double e = 0.0;
+        for (size_t i = 0; i < a.pixel_count() * 4; ++i)
+            if (i % 4 != 3) e += double(a.data[i] - b.data[i]) * double(a.data[i] - b.data[i]);
+        return std::sqrt(e / double(a.pixel_count() * 3));
+    };
+    EXPECT_NEAR(mean(sobol_ref.result.image) / mean(ref.result.image), 1.0, 0.01);
+    double e_sobol = 0.0, e_random = 0.0;
+    for (uint32_t seed : {1u, 2u, 3u}) {
+        e_sobol += rmse(render(32, seed, Sampler::sobol).result.image, ref.result.image);
+        e_random += rmse(render(32, seed, Sampler::random).result.image, ref.result.image);
+    }
+    // The two 1024-spp images differ by their noise alone: far less than a 32-spp image's error.
+    EXPECT_LT(rmse(sobol_ref.result.image, ref.result.image), 0.4 * e_random / 3.0);
+    EXPECT_LT(e_sobol, 0.7 * e_random) << "Sobol " << e_sobol / 3.0 << " vs independent " << e_random / 3.0;
 }
 
 TEST(Render, ValidQuadGlb) {

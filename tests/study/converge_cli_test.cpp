@@ -47,6 +47,7 @@ TEST(Converge, DoublingsToTheLargestSppWithFloorAndSharedSeed) {
     for (const char* k : {"device", "driver", "commit", "command_line", "ref_spp", "reference_seed", "exposure_stops"})
         EXPECT_TRUE(j.contains(k)) << k;
     EXPECT_EQ(j["ref_spp"].get<uint32_t>(), 32u);
+    EXPECT_EQ(j["sampler"].get<std::string>(), "sobol"); // the default (--sampler)
     EXPECT_NE(j["command_line"].get<std::string>().find("converge"), std::string::npos);
     ASSERT_EQ(j["rows"].size(), 3u);
     const uint32_t spps[] = {2, 4, 8};
@@ -91,7 +92,7 @@ TEST(Converge, DoublingsToTheLargestSppWithFloorAndSharedSeed) {
     for (const char* k : {"noise_floor", "flip", "flip_same_seed"})
         EXPECT_EQ(j8["rows"][0][k].get<double>(), j["rows"][2][k].get<double>()) << k;
 
-    // scripts/bench/plot_convergence.py: one panel per run, a PNG, and the table naming the device.
+    // scripts/bench/plot_convergence.py: one panel per scene (both runs in it), a PNG, and the table naming the device.
     const fs::path python = "/usr/bin/python3"; // Debian's, with python3-matplotlib (scripts/setup.sh)
     if (nbvh::test::run_command(python, {"-c", "import matplotlib"}, 60.0).exit_code != 0)
         GTEST_SKIP() << "python3-matplotlib is not installed (scripts/setup.sh installs it): plot not checked";
