@@ -17,9 +17,12 @@ namespace {
 // --sampler sobol|random (render::sampler_name is the flag's word).
 void add_sampler_flag(CLI::App* cmd, render::Sampler& sampler) {
     cmd->add_option_function<std::string>(
-           "--sampler", [&sampler](const std::string& v) { sampler = v == "random" ? render::Sampler::random : render::Sampler::sobol; },
-           "the paths' random numbers: Owen-scrambled Sobol points per pixel (sobol, default: less noise at the "
-           "same spp) or independent numbers (random)")
+           "--sampler",
+           [&sampler](const std::string& v) {
+               sampler = v == "random" ? render::Sampler::random : render::Sampler::sobol;
+           },
+           "the paths' random numbers: Owen-scrambled Sobol points per pixel (sobol, default: less "
+           "noise at the same spp) or independent numbers (random)")
         ->check(CLI::IsMember({"sobol", "random"}));
 }
 

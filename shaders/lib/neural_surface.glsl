@@ -11,9 +11,11 @@
 #ifndef NB_NEURAL_SURFACE_GLSL
 #define NB_NEURAL_SURFACE_GLSL
 #include "lib/neural_bindings.glsl"
+#include "lib/path_sampler.glsl"
 
-// random_bits: a hash of the path's sampler state (the spread's sign; the stream is not advanced).
-Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t, uint random_bits) {
+// ps: the path's numbers; the spread's sign is its NB_PAIR_MATERIAL bit (drawn only where the spread is
+// on, and without moving the path's later numbers: nb_path_bit).
+Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t, PathSampler ps) {
     GpuNeuralRayState st = neural_state[ray];
     Surface s;
     GpuNeuralAsset asset = neural_assets[instances[st.instance].blas_root];
@@ -32,7 +34,8 @@ Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t, ui
         mr = nb_node_fit_eval(unpackHalf2x16(nbvh_bounds_words[b]), unpackHalf2x16(nbvh_bounds_words[b + 1u]),
                               unpackHalf2x16(nbvh_bounds_words[b + 2u]), unpackHalf2x16(nbvh_bounds_words[b + 3u]), s.base);
         if (neural_params.material_spread != 0u)
-            mr = nb_node_fit_spread(mr, unpackHalf2x16(nbvh_bounds_words[b + 4u]), random_bits);
+            mr = nb_node_fit_spread(mr, unpackHalf2x16(nbvh_bounds_words[b + 4u]),
+                                    nb_path_bit(ps, NB_PAIR_MATERIAL));
     } else if (neural_params.materials != 0u) {
         mr = unpackUnorm2x16(nbvh_bounds_words[neural_params.materials + st.hit_leaf]);
     }

@@ -41,6 +41,16 @@ vec2 nb_path_2d(inout PathSampler ps, uint pair) {
     return vec2(u1, u2);
 }
 
+// One random bit for a decision only some renders of a seed make (a neural hit's material spread):
+// under --sampler random it must not advance the PCG stream, so that a hybrid render and its classical
+// reference of the same seed keep sharing their numbers (nbvh bench's shared-seed FLIP); a Sobol pair
+// is fixed per decision anyway.
+uint nb_path_bit(PathSampler ps, uint pair) {
+    if (params.path_sampler == NB_SAMPLER_SOBOL)
+        return nb_qmc_2d(ps.sample_index, nb_qmc_dim_seed(ps.pixel_seed, ps.depth, pair)).x < 0.5f ? 0u : 1u;
+    return nb_pcg_hash(ps.rng ^ 0xA511E9B3u) & 1u;
+}
+
 // NB_RAY_RNG for the path's next segment.
 uint nb_path_next_rng(PathSampler ps) { return nb_pcg_hash(ps.rng ^ 0x2545F491u); }
 

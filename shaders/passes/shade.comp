@@ -11,8 +11,8 @@
 #include "lib/material.glsl"
 #include "lib/env.glsl"
 #include "lib/lights.glsl"
-#include "lib/neural_surface.glsl"
 #include "lib/path_sampler.glsl"
+#include "lib/neural_surface.glsl"
 #include "shared/intersect.h"
 
 layout(local_size_x = NB_WAVEFRONT_GROUP) in;
@@ -44,8 +44,9 @@ void main() {
     }
     float t = uintBitsToFloat(hit_load1(NB_HIT_T, i));
     uint tri_index = hit_load1(NB_HIT_TRIANGLE, i);
-    Surface s = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE) ? nb_make_neural_surface(i, org, dir, t, uint(2.0f * nb_path_2d(ps, NB_PAIR_MATERIAL).x))
-                                                                   : nb_make_surface(instance, tri_index, hit_load_bary(i), org, dir, t);
+    Surface s = (NB_HAS_NEURAL && tri_index == NB_NEURAL_TRIANGLE)
+                    ? nb_make_neural_surface(i, org, dir, t, ps)
+                    : nb_make_surface(instance, tri_index, hit_load_bary(i), org, dir, t);
     vec3 wo = -dir;
 
     if (NB_HAS_EMISSION && dot(s.emission, s.emission) > 0.0f) {

@@ -39,8 +39,10 @@ NB_FN float nb_rng_next(NB_INOUT(uint) state) {
 // Each 2D sample dimension pair of a path (pixel jitter, a bounce's light sample, its BSDF sample, ...)
 // takes the first two Sobol dimensions (a (0,2)-sequence), its index shuffled and its values scrambled
 // by nested uniform (Owen) scrambling seeded per pixel and dimension: every power-of-two prefix of a
-// pixel's samples is a stratified (0,m,2)-net in each pair, and the pairs are independent ("padding").
-// Unbiased like independent samples; the variance of smooth integrands falls faster than 1/spp.
+// pixel's samples is a stratified (0,m,2)-net in each pair, and the pairs are randomised independently
+// ("padding": a product of functions of two pairs is not stratified jointly and may even have somewhat
+// more variance than with independent numbers). Unbiased like independent samples; the variance of
+// smooth integrands of one pair falls faster than 1/spp.
 #ifdef NB_GLSL
 #define nb_reverse_bits(x) bitfieldReverse(x)
 #else

@@ -17,5 +17,6 @@ void main() {
     if (c >= push.count) return;
     uvec2 k = cases[c];
     vec2 u = nb_qmc_2d(k.x, k.y);
-    results[c] = uvec4(floatBitsToUint(u.x), floatBitsToUint(u.y), nb_owen_scramble(k.x, k.y), nb_sobol_dim1(k.x));
+    results[c] = uvec4(floatBitsToUint(u.x), floatBitsToUint(u.y), nb_owen_scramble(k.x, k.y),
+                       nb_sobol_dim1(k.x));
 }

@@ -92,7 +92,8 @@ TEST(Converge, DoublingsToTheLargestSppWithFloorAndSharedSeed) {
     for (const char* k : {"noise_floor", "flip", "flip_same_seed"})
         EXPECT_EQ(j8["rows"][0][k].get<double>(), j["rows"][2][k].get<double>()) << k;
 
-    // scripts/bench/plot_convergence.py: one panel per scene (both runs in it), a PNG, and the table naming the device.
+    // scripts/bench/plot_convergence.py: one panel per scene (both runs in it), a PNG, and the table
+    // naming the device.
     const fs::path python = "/usr/bin/python3"; // Debian's, with python3-matplotlib (scripts/setup.sh)
     if (nbvh::test::run_command(python, {"-c", "import matplotlib"}, 60.0).exit_code != 0)
         GTEST_SKIP() << "python3-matplotlib is not installed (scripts/setup.sh installs it): plot not checked";
