@@ -33,9 +33,13 @@ PathSampler nb_path_sampler(uint slot, uint depth, uint rng) {
     return ps;
 }
 
+// The Sobol point of one pair of the path's segment.
+vec2 nb_path_sobol(PathSampler ps, uint pair) {
+    return nb_qmc_2d(ps.sample_index, nb_qmc_dim_seed(ps.pixel_seed, ps.depth, pair));
+}
+
 vec2 nb_path_2d(inout PathSampler ps, uint pair) {
-    if (params.path_sampler == NB_SAMPLER_SOBOL)
-        return nb_qmc_2d(ps.sample_index, nb_qmc_dim_seed(ps.pixel_seed, ps.depth, pair));
+    if (params.path_sampler == NB_SAMPLER_SOBOL) return nb_path_sobol(ps, pair);
     float u1 = nb_rng_next(ps.rng);
     float u2 = nb_rng_next(ps.rng);
     return vec2(u1, u2);
@@ -46,8 +50,7 @@ vec2 nb_path_2d(inout PathSampler ps, uint pair) {
 // reference of the same seed keep sharing their numbers (nbvh bench's shared-seed FLIP); a Sobol pair
 // is fixed per decision anyway.
 uint nb_path_bit(PathSampler ps, uint pair) {
-    if (params.path_sampler == NB_SAMPLER_SOBOL)
-        return nb_qmc_2d(ps.sample_index, nb_qmc_dim_seed(ps.pixel_seed, ps.depth, pair)).x < 0.5f ? 0u : 1u;
+    if (params.path_sampler == NB_SAMPLER_SOBOL) return nb_path_sobol(ps, pair).x < 0.5f ? 0u : 1u;
     return nb_pcg_hash(ps.rng ^ 0xA511E9B3u) & 1u;
 }
 
