@@ -132,24 +132,29 @@ TEST(Render, SameSeedSameImage) {
 
 // A small image traces several samples per wave (a path per slot: nb_slot_pixel / nb_slot_sample) and
 // accumulates each pixel's slots; the image must equal the one-sample-per-wave render of the same
-// random numbers (float summation order aside). 21 spp at 16 samples per wave: a full and a partial wave.
+// random numbers (float summation order aside), with either sampler. 21 spp at 16 samples per wave: a
+// full and a partial wave.
 TEST(Render, SamplesPerWaveKeepTheImage) {
     Scene s = test::make_quad_scene();
     const Environment env = constant_environment(glm::vec3(1.0f));
     const uint32_t w = 24, h = 16, spp = 21;
-    const Rendered one = render_small(s, env, spp, 3, 5, w, h, w * h);  // waves of exactly the image
-    const Rendered many = render_small(s, env, spp, 3, 5, w, h, 1u << 22); // up to 16 samples per wave
-    expect_sane(one);
-    expect_sane(many);
-    EXPECT_EQ(one.result.stats.rays_primary, many.result.stats.rays_primary);
-    EXPECT_EQ(one.result.stats.rays_secondary, many.result.stats.rays_secondary);
-    EXPECT_EQ(one.result.stats.rays_shadow, many.result.stats.rays_shadow);
-    ASSERT_EQ(one.result.image.data.size(), many.result.image.data.size());
-    double worst = 0.0;
-    for (size_t i = 0; i < one.result.image.data.size(); ++i)
-        worst = std::max(worst, double(std::abs(one.result.image.data[i] - many.result.image.data[i])) /
-                                    std::max(1e-3, double(std::abs(one.result.image.data[i]))));
-    EXPECT_LT(worst, 1e-5) << "several samples per wave changed the image";
+    for (Sampler sampler : {Sampler::sobol, Sampler::random}) {
+        SCOPED_TRACE(sampler_name(sampler));
+        const bool sort = RenderOptions{}.sort_rays;
+        const Rendered one = render_small(s, env, spp, 3, 5, w, h, w * h, sort, sampler); // waves of the image
+        const Rendered many = render_small(s, env, spp, 3, 5, w, h, 1u << 22, sort, sampler); // 16 samples each
+        expect_sane(one);
+        expect_sane(many);
+        EXPECT_EQ(one.result.stats.rays_primary, many.result.stats.rays_primary);
+        EXPECT_EQ(one.result.stats.rays_secondary, many.result.stats.rays_secondary);
+        EXPECT_EQ(one.result.stats.rays_shadow, many.result.stats.rays_shadow);
+        ASSERT_EQ(one.result.image.data.size(), many.result.image.data.size());
+        double worst = 0.0;
+        for (size_t i = 0; i < one.result.image.data.size(); ++i)
+            worst = std::max(worst, double(std::abs(one.result.image.data[i] - many.result.image.data[i])) /
+                                        std::max(1e-3, double(std::abs(one.result.image.data[i]))));
+        EXPECT_LT(worst, 1e-5) << "several samples per wave changed the image";
+    }
 }
 
 bool ran_pass(const Rendered& r, const char* name) {
