@@ -9,7 +9,8 @@
 # Env: DRAGON (xz-packed glb, default .device/study/dragon/dragon_vrip.glb.xz), SPP (default 16), WIDTH, HEIGHT,
 #      TRAIN_ARGS (extra `nbvh train` flags for both models), RENDER_ARGS (extra render flags, both binaries),
 #      OLD_TRAIN_ARGS (when set, OLD renders its own models, trained by OLD with these flags: an A/B of
-#      training settings; OLD may then be the same binary as NEW).
+#      training settings; OLD may then be the same binary as NEW), OLD_RENDER_ARGS (extra render flags
+#      of OLD only: an A/B of render settings with one binary, e.g. OLD_RENDER_ARGS="--sampler random").
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 source scripts/bench/lib.sh
@@ -40,8 +41,10 @@ row() { # NAME ARGS... (@M@ in ARGS: the binary's model folder)
   "$NEW" render "${@//@M@/$T}" "${R[@]}" --spp 4 --out "$T/warm.png" > /dev/null 2>&1
   for rep in 1 2; do
     for b in old new; do
-      local bin=$OLD m=$OLDM; [ $b = new ] && bin=$NEW m=$T
-      "$bin" render "${@//@M@/$m}" "${R[@]}" --spp "$SPP" --out "$T/${name}_$b.png" --stats "$T/${name}_${b}_$rep.json" > /dev/null 2>&1
+      # shellcheck disable=SC2206
+      local bin=$OLD m=$OLDM extra=(${OLD_RENDER_ARGS:-}); [ $b = new ] && bin=$NEW m=$T extra=()
+      "$bin" render "${@//@M@/$m}" "${R[@]}" "${extra[@]}" --spp "$SPP" --out "$T/${name}_$b.png" \
+        --stats "$T/${name}_${b}_$rep.json" > /dev/null 2>&1
     done
   done
   "$NEW" flip "$T/${name}_old.png" "$T/${name}_new.png" 2>&1 | tail -1 > "$T/${name}_flip.txt"
@@ -72,6 +75,7 @@ for name in ["default_classical", "default_hybrid", "dragon_classical", "dragon_
     r["new_over_old"] = r["new"]["ms_per_spp"] / r["old"]["ms_per_spp"]
     rows[name] = r
 json.dump({"old": sys.argv[3], "new": sys.argv[4], "old_train_args": os.environ.get("OLD_TRAIN_ARGS"),
+           "old_render_args": os.environ.get("OLD_RENDER_ARGS"),
            "train_args": os.environ.get("TRAIN_ARGS", ""), "rows": rows}, open(out, "w"), indent=1)
 for k, r in rows.items():
     print("%-18s old %6.2f  new %6.2f ms/spp  new/old %.3f  FLIP old vs new %s" % (
