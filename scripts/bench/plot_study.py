@@ -165,7 +165,8 @@ def table(study):
              f"Device: {study['device']} (driver {study['driver']}); training: {study['training_backend']} "
              f"({study['training_device']}). Commit `{study['commit']}`, {study['written_utc']}.", "",
              f"Command: `{study['command_line']}`", "",
-             f"Images {s['width']}x{s['height']}, {s['spp']} spp (seed {s['seed']}) against a classical reference of "
+             f"Images {s['width']}x{s['height']}, {s['spp']} spp (seed {s['seed']}; "
+             f"{s.get('sampler', 'random')} sampler) against a classical reference of "
              f"{s['ref_spp']} spp (seed {s['reference_seed']}), LDR-FLIP, mean over {len(study['cameras'])} cameras; "
              f"frame time: median of {s['repeat']} frames of {s['time_spp']} spp at {s['time_width']}x{s['time_height']}"
              f" after a warm-up; per-ray leaf budget {s['max_leaves']}, {s['leaves_per_round']} leaves per round, "
