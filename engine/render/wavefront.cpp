@@ -46,6 +46,8 @@ void set_camera_params(GpuFrameParams& p, const Camera& camera, float aspect) {
     p.cam_up = basis.up;
 }
 
+uint32_t gpu_sampler(Sampler s) { return s == Sampler::sobol ? NB_SAMPLER_SOBOL : NB_SAMPLER_RANDOM; }
+
 } // namespace
 
 WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene, const SceneAccel& accel,
@@ -121,7 +123,7 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     p.ray_epsilon = NB_RAY_EPSILON_SCALE * data_.scene_extent;
     p.instance_count = accel.tlas.prim_indices.empty() ? 0u : uint32_t(data_.instances.size());
     p.sort_rays = options_.sort_rays ? 1u : 0u;
-    p.path_sampler = options_.sampler == Sampler::sobol ? NB_SAMPLER_SOBOL : NB_SAMPLER_RANDOM;
+    p.path_sampler = gpu_sampler(options_.sampler);
 
     // Buffers, indexed by binding.
     buffers_.resize(NB_BINDING_COUNT);
@@ -274,7 +276,7 @@ bool WavefrontRenderer::apply(const RenderOptions& o) {
     options_.sort_rays = o.sort_rays;
     params_.sort_rays = o.sort_rays ? 1u : 0u;
     options_.sampler = o.sampler;
-    params_.path_sampler = o.sampler == Sampler::sobol ? NB_SAMPLER_SOBOL : NB_SAMPLER_RANDOM;
+    params_.path_sampler = gpu_sampler(o.sampler);
     buffers_[NB_BIND_PARAMS].upload(&params_, sizeof(params_));
     if (neural_) {
         options_.neural = n;

@@ -23,13 +23,20 @@ struct PathSampler {
     uint depth;
 };
 
-// The sampler of the path in wave slot `slot` at segment `depth`, PCG state `rng`.
+// The sampler of the path in wave slot `slot` at segment `depth`, PCG state `rng` (NB_RAY_RNG).
 PathSampler nb_path_sampler(uint slot, uint depth, uint rng) {
     PathSampler ps;
     ps.rng = rng;
     ps.pixel_seed = nb_qmc_pixel_seed(nb_slot_pixel(slot, pc.pixel_offset, pc.pixel_count), params.seed);
     ps.sample_index = nb_slot_sample(slot, pc.sample_index, pc.pixel_count);
     ps.depth = depth;
+    return ps;
+}
+
+// A camera ray's sampler: segment 0, its PCG state started from pixel, sample and --seed.
+PathSampler nb_camera_path_sampler(uint slot, uint pixel) {
+    PathSampler ps = nb_path_sampler(slot, 0u, 0u);
+    ps.rng = nb_rng_init(pixel, ps.sample_index, params.seed);
     return ps;
 }
 

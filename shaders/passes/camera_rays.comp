@@ -18,8 +18,7 @@ void main() {
     uint pixel = nb_slot_pixel(i, pc.pixel_offset, pc.pixel_count);
     uint x = pixel % params.width;
     uint y = pixel / params.width;
-    uint sample_index = nb_slot_sample(i, pc.sample_index, pc.pixel_count);
-    PathSampler ps = nb_path_sampler(i, 0u, nb_rng_init(pixel, sample_index, params.seed));
+    PathSampler ps = nb_camera_path_sampler(i, pixel);
     vec2 jitter = nb_path_2d(ps, NB_PAIR_CAMERA);
     float jx = jitter.x;
     float jy = jitter.y;
