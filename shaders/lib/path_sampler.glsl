@@ -10,8 +10,8 @@
 #include "shared/sampling.h"
 
 #define NB_PAIR_CAMERA 0u      // segment 0: pixel jitter (x, y)
-#define NB_PAIR_LIGHT_PICK 1u  // x: light strategy, y: which light of it
-#define NB_PAIR_LIGHT 2u       // the point or direction on the light
+#define NB_PAIR_LIGHT_PICK 1u  // y: which light of the strategy (x: unused; the strategy is NB_PAIR_LIGHT's x)
+#define NB_PAIR_LIGHT 2u       // the strategy (x, rescaled), then the point or direction on the light
 #define NB_PAIR_LOBE 3u        // x: BSDF lobe, y: Russian roulette
 #define NB_PAIR_BSDF 4u        // the BSDF direction
 #define NB_PAIR_MATERIAL 5u    // x: the neural surface's material spread sign

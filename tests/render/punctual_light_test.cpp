@@ -303,5 +303,50 @@ TEST(PunctualLights, EnvironmentPlusLightIsTheSumOfBoth) {
     EXPECT_NEAR(a / b, 1.0, 0.02);
 }
 
+// The same with an emissive quad instead of the punctual light, under a dim sky with a small bright sun
+// (whose next-event samples carry nearly all its MIS weight): the environment and emissive strategies
+// take their choice from the light sample's own first coordinate, rescaled to [0, 1) for the chosen one
+// (shade.comp). Without the rescale each strategy would sample only part of its light and lose the
+// rest of that light's next-event share.
+TEST(PunctualLights, EnvironmentPlusEmissiveQuadIsTheSumOfBoth) {
+    Scene s = lit_plane(PunctualLight{});
+    s.lights.clear();
+    Material lamp;
+    lamp.emissive = glm::vec3(12.0f);
+    lamp.base_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+    s.materials.push_back(lamp);
+    Mesh quad = s.meshes[0]; // 10 m (lit_plane scaled it): 0.6 m below
+    quad.triangle_material.assign(quad.triangle_material.size(), 1u);
+    s.meshes.push_back(quad);
+    Instance li;
+    li.mesh = 1;
+    // 0.6 m square at z = 1.2 facing down (180 degrees about x), off the image centre.
+    li.object_to_world = glm::mat4(0.06f, 0, 0, 0, 0, -0.06f, 0, 0, 0, 0, -1, 0, 0.3f, 0.2f, 1.2f, 1);
+    s.instances.push_back(li);
+    Environment sky;
+    sky.width = 64;
+    sky.height = 32;
+    sky.rgb.assign(size_t(sky.width) * sky.height * 3, 0.05f);
+    for (uint32_t y = 9; y < 12; ++y) // a 3x3-texel sun above the plane (+z, tilted towards +y)
+        for (uint32_t x = 62; x < 64; ++x)
+            for (int c = 0; c < 3; ++c) sky.rgb[(size_t(y) * sky.width + x) * 3 + size_t(c)] = 60.0f;
+    const Rendered both = render(s, sky, 64, 3);
+    Scene no_lamp = s; // the quad stays, black: it shades the plane from the sky in both renders
+    no_lamp.materials[1].emissive = glm::vec3(0.0f);
+    const Rendered env_only = render(no_lamp, sky, 64, 3);
+    const Rendered lamp_only = render(s, Environment{}, 64, 3);
+    double a = 0.0, b = 0.0, lamp_sum = 0.0;
+    for (size_t i = 0; i < both.image.pixel_count(); ++i) {
+        a += both.image.data[i * 4 + 1];
+        b += env_only.image.data[i * 4 + 1] + lamp_only.image.data[i * 4 + 1];
+        lamp_sum += lamp_only.image.data[i * 4 + 1];
+    }
+    std::printf("  environment + emissive quad vs the sum of the two: ratio %.4f (lamp %.1f %% of it)\n", a / b,
+                100.0 * lamp_sum / b);
+    EXPECT_GT(lamp_sum, 0.1 * b); // both lights matter
+    EXPECT_LT(lamp_sum, 0.8 * b);
+    EXPECT_NEAR(a / b, 1.0, 0.02);
+}
+
 } // namespace
 } // namespace nbvh::render
