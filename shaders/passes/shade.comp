@@ -72,8 +72,8 @@ void main() {
         vec2 ul = nb_path_2d(ps, NB_PAIR_LIGHT);
         // The strategy comes from the light sample's own first coordinate, rescaled to [0, 1) for the
         // chosen strategy (pbrt's sample reuse): under --sampler sobol the samples of each strategy stay
-        // a stratified 2D net instead of a random subset of one (default scene, 240x135, 64 spp, max
-        // depth 2: floor FLIP 0.0266 -> 0.0245; the strategy drawn from a pair of its own before).
+        // a stratified 2D net instead of a random subset of one (default scene, 240x135, 64 spp, two
+        // seeds: FLIP 0.0268 -> 0.0248; engine/render/README.md; the strategy had a pair of its own).
         float u = ul.x;
         if (NB_HAS_ENVIRONMENT && u < p_env) {
             ul.x = min(u / p_env, 0.99999994f);
