@@ -8,7 +8,8 @@
 //   directional:  E = illuminance (lux)
 //   range:        E *= clamp(1 - (d / range)^4, 0, 1)^2
 // f comes from the shared BSDF functions (shared/sampling.h: diffuse base / pi + Schlick-GGX specular), so
-// what is checked is the light's irradiance and its placement, not the BSDF.
+// what is checked is the light's irradiance and its placement, not the BSDF. The last two tests check that
+// the next-event strategies add up (environment + punctual light, environment + emissive quad).
 #include <gtest/gtest.h>
 
 #include <cmath>
