@@ -316,7 +316,7 @@ TEST(PunctualLights, EnvironmentPlusEmissiveQuadIsTheSumOfBoth) {
     lamp.emissive = glm::vec3(12.0f);
     lamp.base_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
     s.materials.push_back(lamp);
-    Mesh quad = s.meshes[0]; // 10 m (lit_plane scaled it): 0.6 m below
+    Mesh quad = s.meshes[0]; // 10 m square (lit_plane scaled it); the instance shrinks it to 0.6 m
     quad.triangle_material.assign(quad.triangle_material.size(), 1u);
     s.meshes.push_back(quad);
     Instance li;
@@ -328,7 +328,7 @@ TEST(PunctualLights, EnvironmentPlusEmissiveQuadIsTheSumOfBoth) {
     sky.width = 64;
     sky.height = 32;
     sky.rgb.assign(size_t(sky.width) * sky.height * 3, 0.05f);
-    for (uint32_t y = 9; y < 12; ++y) // a 3x3-texel sun above the plane (+z, tilted towards +y)
+    for (uint32_t y = 9; y < 12; ++y) // a 2x3-texel sun above the plane (+z, tilted towards +y)
         for (uint32_t x = 62; x < 64; ++x)
             for (int c = 0; c < 3; ++c) sky.rgb[(size_t(y) * sky.width + x) * 3 + size_t(c)] = 60.0f;
     const Rendered both = render(s, sky, 64, 3);
