@@ -171,6 +171,7 @@ TEST(Study, TinySweepWritesCsvJsonAndPlots) {
     std::stringstream text;
     text << t.rdbuf();
     EXPECT_NE(text.str().find("noise floor"), std::string::npos);
+    EXPECT_NE(text.str().find("that meet the issue's rule"), std::string::npos) << "per-camera rule count";
     EXPECT_NE(text.str().find("llvmpipe"), std::string::npos) << "the device is named";
 }
 
