@@ -71,16 +71,16 @@ void main() {
         vec2 pick = nb_path_2d(ps, NB_PAIR_LIGHT_PICK);
         vec2 ul = nb_path_2d(ps, NB_PAIR_LIGHT);
         // The strategy comes from the light sample's own first coordinate, rescaled to [0, 1) for the
-        // chosen strategy (pbrt's sample reuse): under --sampler sobol the samples of each strategy stay
+        // chosen strategy (nb_sample_reuse): under --sampler sobol the samples of each strategy stay
         // a stratified 2D net instead of a random subset of one (default scene, 240x135, 64 spp, two
         // seeds: FLIP 0.0268 -> 0.0248; engine/render/README.md; the strategy had a pair of its own).
         float u = ul.x;
         if (NB_HAS_ENVIRONMENT && u < p_env) {
-            ul.x = min(u / p_env, 0.99999994f);
+            ul.x = nb_sample_reuse(u, 0.0f, p_env);
             le = nb_env_sample(ul, wi, light_pdf);
             light_pdf *= p_env;
         } else if (NB_HAS_EMISSION && p_emissive > 0.0f && u < p_env + p_emissive) {
-            ul.x = min((u - p_env) / p_emissive, 0.99999994f);
+            ul.x = nb_sample_reuse(u, p_env, p_emissive);
             le = nb_emissive_sample(s.p, pick.y, ul, wi, dist, light_pdf);
             light_pdf *= p_emissive;
         } else if (NB_HAS_PUNCTUAL && p_punctual > 0.0f) {

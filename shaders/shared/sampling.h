@@ -103,6 +103,12 @@ NB_FN vec2 nb_qmc_2d(uint sample_index, uint dim_seed) {
     return vec2(float(x >> 8u), float(y >> 8u)) * (1.0f / 16777216.0f);
 }
 
+// Sample reuse (pbrt-v4 §2.2.1): a uniform u that fell in [lo, lo + p) and chose that interval's option,
+// rescaled to [0, 1) to serve as the chosen option's own number: when u is one coordinate of a net, the
+// points that chose an option stay a net of the option's own (fewer points, the same stratification).
+// Kept below 1 (p may be tiny, or u sit on the interval's far end by rounding).
+NB_FN float nb_sample_reuse(float u, float lo, float p) { return min((u - lo) / p, 0.99999994f); }
+
 // ---- Helpers --------------------------------------------------------------------------------------
 NB_FN float nb_luminance(vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 

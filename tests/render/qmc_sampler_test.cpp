@@ -1,8 +1,8 @@
 // The quasi-random sampler of the path tracer (shaders/shared/sampling.h nb_qmc_2d: shuffled,
 // Owen-scrambled Sobol, Burley 2020) on the CPU: the first two Sobol dimensions, nets at every
 // power-of-two prefix and block (the property the variance reduction rests on), uniform and
-// independent across seeds, and a lower error than independent numbers on integrands a path tracer
-// meets (smooth, and with an edge).
+// independent across seeds, a lower error than independent numbers on integrands a path tracer meets
+// (smooth, and with an edge), and sample reuse (nb_sample_reuse) keeping a chosen subset a net.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -70,6 +70,58 @@ TEST(QmcSampler, EveryPowerOfTwoBlockIsANet) {
     for (uint seed : {0u, 1u, 12345u, nb_qmc_dim_seed(nb_qmc_pixel_seed(640u * 360u + 17u, 0u), 3u, 4u)})
         for (uint m = 0; m <= 10; ++m)
             for (uint first : {0u, 1u << m, 5u << m}) expect_net(first, m, seed);
+}
+
+// Sample reuse (shade.comp's next-event strategy): the points of a 2^m net whose x chose [lo, lo + p)
+// with p = 2^-j and lo a multiple of it, x rescaled by nb_sample_reuse, are a (0, m - j, 2)-net.
+TEST(QmcSampler, SampleReuseKeepsTheChosenPointsANet) {
+    const uint m = 10;
+    for (uint seed : {3u, 999u, nb_qmc_dim_seed(nb_qmc_pixel_seed(77u, 5u), 1u, 2u)})
+        for (uint j : {1u, 2u})
+            for (uint part = 0; part < (1u << j); ++part) {
+                const float p = 1.0f / float(1u << j), lo = float(part) * p;
+                std::vector<vec2> pts;
+                for (uint i = 0; i < (1u << m); ++i) {
+                    const vec2 u = nb_qmc_2d(i, seed);
+                    if (u.x >= lo && u.x < lo + p) pts.push_back(vec2(nb_sample_reuse(u.x, lo, p), u.y));
+                }
+                const uint mm = m - j, n = 1u << mm;
+                ASSERT_EQ(pts.size(), n);
+                for (uint k = 0; k <= mm; ++k) {
+                    std::vector<int> cells(n, 0);
+                    for (const vec2& q : pts) {
+                        ASSERT_GE(q.x, 0.0f);
+                        ASSERT_LT(q.x, 1.0f);
+                        ++cells[uint(q.x * float(1u << k)) * (1u << (mm - k)) + uint(q.y * float(1u << (mm - k)))];
+                    }
+                    for (uint c = 0; c < n; ++c)
+                        ASSERT_EQ(cells[c], 1) << "seed " << seed << ", p 2^-" << j << ", part " << part << ", k " << k;
+                }
+            }
+}
+
+// Its hard cases: the interval's ends, a tiny or rounding-prone interval, the largest float below 1.
+TEST(QmcSampler, SampleReuseStaysInTheUnitInterval) {
+    const float below_one = 0.99999994f;
+    EXPECT_EQ(nb_sample_reuse(0.25f, 0.25f, 0.5f), 0.0f);
+    EXPECT_LT(nb_sample_reuse(std::nextafter(0.75f, 0.0f), 0.25f, 0.5f), 1.0f);
+    EXPECT_LT(nb_sample_reuse(below_one, 0.0f, 1.0f), 1.0f);
+    EXPECT_EQ(nb_sample_reuse(below_one, 0.0f, 1.0f), below_one); // one strategy: the number unchanged
+    EXPECT_LT(nb_sample_reuse(below_one, 2.0f / 3.0f, 1.0f / 3.0f), 1.0f);
+    const float tiny = 1.0e-7f; // an option of probability 1e-7: u in [0.5, 0.5 + 1e-7)
+    for (float u = 0.5f; u < 0.5f + tiny; u = std::nextafter(u, 1.0f)) {
+        const float r = nb_sample_reuse(u, 0.5f, tiny);
+        ASSERT_TRUE(std::isfinite(r));
+        ASSERT_GE(r, 0.0f);
+        ASSERT_LT(r, 1.0f);
+    }
+    for (float lo : {0.1f, 1.0f / 3.0f, 0.7f})
+        for (float p : {0.2f, 1.0f / 7.0f, 0.3f}) {
+            if (lo + p > 1.0f) continue;
+            const float hi = std::nextafter(lo + p, 0.0f); // the last u that still chose [lo, lo + p)
+            EXPECT_LT(nb_sample_reuse(hi, lo, p), 1.0f) << lo << " " << p;
+            EXPECT_GE(nb_sample_reuse(lo, lo, p), 0.0f) << lo << " " << p;
+        }
 }
 
 TEST(QmcSampler, SeedsGiveUniformIndependentSequences) {
