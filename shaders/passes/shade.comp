@@ -68,7 +68,8 @@ void main() {
         float light_pdf = 0.0f, dist = NB_INF;
         vec3 le = vec3(0.0f);
         bool delta = false; // punctual: light_pdf is a discrete probability, no MIS
-        vec2 pick = nb_path_2d(ps, NB_PAIR_LIGHT_PICK);
+        // Which light within the strategy: only scenes with emitters or punctual lights draw it.
+        vec2 pick = (NB_HAS_EMISSION || NB_HAS_PUNCTUAL) ? nb_path_2d(ps, NB_PAIR_LIGHT_PICK) : vec2(0.0f);
         vec2 ul = nb_path_2d(ps, NB_PAIR_LIGHT);
         // The strategy comes from the light sample's own first coordinate, rescaled to [0, 1) for the
         // chosen strategy (nb_sample_reuse): under --sampler sobol the samples of each strategy stay
