@@ -1,5 +1,6 @@
 #include "engine/render/environment_sampler.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "shaders/shared/sampling.h"
@@ -20,23 +21,48 @@ EnvironmentTable build_environment_table(const Environment& env) {
     t.height = map ? env.height : 1;
     const uint32_t w = t.width, h = t.height;
     const size_t texels = size_t(w) * h;
-    t.data.assign(texels * 3 + (h + 1) + size_t(h) * (w + 1), 0.0f);
+    t.data.assign(texels * 3 + (h + 1) + size_t(h) * (w + 1) + texels, 0.0f);
     for (size_t i = 0; i < texels; ++i)
         for (int c = 0; c < 3; ++c) t.data[i * 3 + c] = clean(map ? env.rgb[i * 3 + c] : env.constant[c]);
 
-    // f = luminance * sin(theta) at row centres; rows in double for long sums.
+    // The shader reads the map bilinearly (texel centres at half-integers, u wraps, v clamps), so a texel's
+    // share of the samples follows the mean of that bilinear function over the texel: its luminance and
+    // its 8 neighbours' with weights (1/8, 3/4, 1/8) per axis (pbrt-v4 builds its image light's
+    // distribution from the bilinear lookup the same way). Sampling only with the texels' own values
+    // would leave a bright texel's neighbours, which the bilinear lookup lights up to half of it, with a
+    // small density: fireflies.
+    std::vector<float> lum(texels);
+    for (size_t i = 0; i < texels; ++i) {
+        const float* p = t.data.data() + i * 3;
+        lum[i] = nb_luminance(vec3(p[0], p[1], p[2]));
+    }
+    const float wk[3] = {0.125f, 0.75f, 0.125f};
+    auto filtered = [&](uint32_t x, uint32_t y) {
+        double s = 0.0;
+        for (int j = -1; j <= 1; ++j) {
+            const uint32_t yy = uint32_t(std::clamp(int(y) + j, 0, int(h) - 1));
+            for (int i = -1; i <= 1; ++i) {
+                const uint32_t xx = uint32_t((int(x) + i + int(w)) % int(w));
+                s += double(wk[i + 1] * wk[j + 1]) * double(lum[size_t(yy) * w + xx]);
+            }
+        }
+        return s;
+    };
+
+    // f = filtered luminance * sin(theta) at row centres; rows in double for long sums.
     float* marginal = t.data.data() + texels * 3;
     float* conditional = marginal + (h + 1);
-    std::vector<double> row_sum(h, 0.0);
+    float* density = conditional + size_t(h) * (w + 1);
+    std::vector<double> row_sum(h, 0.0), f(texels, 0.0);
     double total = 0.0;
     for (uint32_t y = 0; y < h; ++y) {
-        const float sin_theta = std::sin(NB_PI * (float(y) + 0.5f) / float(h));
+        const double sin_theta = std::sin(NB_PI * (float(y) + 0.5f) / float(h));
         float* cdf = conditional + size_t(y) * (w + 1);
         double acc = 0.0;
         cdf[0] = 0.0f;
         for (uint32_t x = 0; x < w; ++x) {
-            const float* p = t.data.data() + (size_t(y) * w + x) * 3;
-            acc += double(nb_luminance(vec3(p[0], p[1], p[2])) * sin_theta);
+            f[size_t(y) * w + x] = filtered(x, y) * sin_theta;
+            acc += f[size_t(y) * w + x];
             cdf[x + 1] = float(acc);
         }
         for (uint32_t x = 1; x <= w; ++x) cdf[x] = acc > 0.0 ? float(cdf[x] / acc) : float(x) / float(w);
@@ -52,13 +78,14 @@ EnvironmentTable build_environment_table(const Environment& env) {
     }
     marginal[h] = 1.0f;
     t.inv_mean = total > 0.0 ? float(double(texels) / total) : 0.0f;
+    // Density in (u, v) of each texel (f / mean f): what the shader's pdf reads (nb_env_texel_density).
+    for (size_t i = 0; i < texels; ++i) density[i] = float(f[i] * double(t.inv_mean));
     return t;
 }
 
 float environment_density(const EnvironmentTable& t, uint32_t x, uint32_t y) {
-    const float* p = t.data.data() + (size_t(y) * t.width + x) * 3;
-    const float sin_theta = std::sin(NB_PI * (float(y) + 0.5f) / float(t.height));
-    return nb_luminance(vec3(p[0], p[1], p[2])) * sin_theta * t.inv_mean;
+    const size_t texels = size_t(t.width) * t.height;
+    return t.data[texels * 3 + (t.height + 1) + size_t(t.height) * (t.width + 1) + size_t(y) * t.width + x];
 }
 
 } // namespace nbvh::render

@@ -1,6 +1,7 @@
 // CPU side of environment importance sampling: the piecewise-constant 2D distribution over texels with
-// density proportional to luminance * sin(theta) (pbrt-v4 §12.6), packed the way shaders/lib/env.glsl
-// reads it: rgb texels (w*h*3), marginal row cdf (h+1), conditional cdfs (h*(w+1)).
+// density proportional to the texel's mean of the bilinearly filtered luminance * sin(theta) (pbrt-v4
+// §12.6), packed the way shaders/lib/env.glsl reads it: rgb texels (w*h*3), marginal row cdf (h+1),
+// conditional cdfs (h*(w+1)), per-texel densities in (u, v) (w*h).
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -20,7 +21,7 @@ struct EnvironmentTable {
 // A constant environment becomes a 1x1 map. Non-finite or negative texels are read as 0.
 EnvironmentTable build_environment_table(const Environment& env);
 
-// Density in (u, v) of the texel containing uv (for tests; the shader's nb_env_texel_density).
+// Density in (u, v) of texel (x, y): the value the shader's nb_env_texel_density reads.
 float environment_density(const EnvironmentTable& table, uint32_t x, uint32_t y);
 
 } // namespace nbvh::render

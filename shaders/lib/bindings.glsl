@@ -42,7 +42,8 @@ layout(set = 0, binding = NB_BIND_TEXTURE_INFOS, scalar) readonly buffer Texture
 layout(set = 0, binding = NB_BIND_LIGHTS, scalar) readonly buffer LightBuffer { GpuLight lights[]; };
 layout(set = 0, binding = NB_BIND_LIGHT_CDF, scalar) readonly buffer LightCdfBuffer { float light_cdf[]; };
 // Environment: rgb texels (width*height*3), then the marginal row cdf (height+1), then one conditional
-// cdf per row (height*(width+1)); layout written by engine/render/environment_sampler.cpp.
+// cdf per row (height*(width+1)), then the texels' densities (width*height); layout written by
+// engine/render/environment_sampler.cpp.
 layout(set = 0, binding = NB_BIND_ENV, scalar) readonly buffer EnvBuffer { float env_data[]; };
 layout(set = 0, binding = NB_BIND_RAYS, scalar) buffer RayBuffer { uint ray_words[]; };
 layout(set = 0, binding = NB_BIND_HITS, scalar) buffer HitBuffer { uint hit_words[]; };

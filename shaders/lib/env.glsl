@@ -1,5 +1,9 @@
-// Environment lookups and importance sampling (piecewise-constant over texels, density proportional
-// to luminance * sin(theta); pbrt-v4 §12.6). Buffer layout: bindings.glsl (NB_BIND_ENV).
+// Environment lookups and importance sampling (pbrt-v4 §12.6). Radiance is read bilinearly (texel centres
+// at half-integers, u wraps, v clamps): a sky or map seen directly has no texel steps. Directions are drawn
+// piecewise-constant over texels, with densities the CPU built from each texel's mean of that bilinear
+// luminance * sin(theta) (engine/render/environment_sampler.cpp); the pdf is that of the sampling
+// procedure, so NEE and MIS stay unbiased with the filtered radiance. Buffer layout: rgb texels, marginal
+// cdf, conditional cdfs, densities (bindings.glsl NB_BIND_ENV).
 #ifndef NB_ENV_GLSL
 #define NB_ENV_GLSL
 #include "lib/bindings.glsl"
@@ -15,10 +19,24 @@ uint nb_env_conditional_base(uint row) {
     return nb_env_marginal_base() + params.env_height + 1u + row * (params.env_width + 1u);
 }
 
-// Density in (u, v) of texel (x, y): f / mean(f).
-float nb_env_texel_density(uint x, uint y) {
-    float sin_theta = sin(NB_PI * (float(y) + 0.5f) / float(params.env_height));
-    return nb_luminance(nb_env_texel(x, y)) * sin_theta * params.env_inv_mean;
+uint nb_env_density_base() { return nb_env_conditional_base(params.env_height); }
+
+// Density in (u, v) of texel (x, y): f / mean(f), precomputed.
+float nb_env_texel_density(uint x, uint y) { return env_data[nb_env_density_base() + y * params.env_width + x]; }
+
+// Bilinear radiance at (u, v) in [0, 1]^2 (before the intensity).
+vec3 nb_env_bilinear(vec2 uv) {
+    float fx = uv.x * float(params.env_width) - 0.5f;
+    float fy = uv.y * float(params.env_height) - 0.5f;
+    float x0f = floor(fx), y0f = floor(fy);
+    float ax = fx - x0f, ay = fy - y0f;
+    int w = int(params.env_width), h = int(params.env_height);
+    int xi = int(x0f);
+    uint x0 = uint(((xi % w) + w) % w), x1 = uint((((xi + 1) % w) + w) % w);
+    uint y0 = uint(clamp(int(y0f), 0, h - 1)), y1 = uint(clamp(int(y0f) + 1, 0, h - 1));
+    vec3 top = mix(nb_env_texel(x0, y0), nb_env_texel(x1, y0), ax);
+    vec3 bottom = mix(nb_env_texel(x0, y1), nb_env_texel(x1, y1), ax);
+    return mix(top, bottom, ay);
 }
 
 void nb_env_texel_of(vec3 dir, out uint x, out uint y, out float sin_theta) {
@@ -28,12 +46,7 @@ void nb_env_texel_of(vec3 dir, out uint x, out uint y, out float sin_theta) {
     sin_theta = sin(uv.y * NB_PI);
 }
 
-vec3 nb_env_radiance(vec3 dir) {
-    uint x, y;
-    float st;
-    nb_env_texel_of(dir, x, y, st);
-    return nb_env_texel(x, y) * params.env_intensity;
-}
+vec3 nb_env_radiance(vec3 dir) { return nb_env_bilinear(nb_env_dir_to_uv(dir, params.env_rotation)) * params.env_intensity; }
 
 // Solid-angle pdf of nb_env_sample producing dir.
 float nb_env_pdf(vec3 dir) {
@@ -71,7 +84,7 @@ vec3 nb_env_sample(vec2 u, out vec3 dir, out float pdf) {
     dir = nb_env_uv_to_dir(uv, params.env_rotation);
     float sin_theta = sin(uv.y * NB_PI);
     pdf = sin_theta > 1.0e-6f ? nb_env_texel_density(x, y) / (2.0f * NB_PI * NB_PI * sin_theta) : 0.0f;
-    return nb_env_texel(x, y) * params.env_intensity;
+    return nb_env_bilinear(uv) * params.env_intensity;
 }
 
 #endif

@@ -129,7 +129,7 @@ struct GpuFrameParams {
     // + 0.5, v = acos(d.y)/pi (official implementation §8). A constant environment is a 1x1 map.
     uint env_width;  uint env_height;
     float env_intensity; float env_rotation;
-    float env_inv_mean; // 1 / mean(luminance * sin(theta)) over the map: converts f(u,v) into a pdf
+    float env_inv_mean; // 1 / mean(filtered luminance * sin(theta)); 0: a black map (no strategy)
     // emissive-triangle lights
     uint light_count;      // emissive triangles (0 when they have no power)
     float light_total_power; // sum of luminance(emissive) * area

@@ -135,6 +135,32 @@ TEST(EnvironmentTable, CdfsAreMonotoneAndDensityAveragesToOne) {
     EXPECT_NEAR(mean / (16 * 8), 1.0, 1e-4);
 }
 
+// The shader reads the map bilinearly, so a texel's density is the mean of that bilinear function over it:
+// (1/8, 3/4, 1/8) of itself and its neighbours per axis, u wrapping across the seam, v clamped at the poles.
+TEST(EnvironmentTable, DensityIsTheBilinearMeanOfEachTexel) {
+    Environment env;
+    env.width = 8;
+    env.height = 4;
+    env.rgb.assign(8 * 4 * 3, 0.0f);
+    auto set = [&](uint32_t x, uint32_t y) { for (int c = 0; c < 3; ++c) env.rgb[(size_t(y) * 8 + x) * 3 + c] = 1.0f; };
+    set(0, 1); // on the seam
+    set(4, 0); // on the pole row
+    const EnvironmentTable t = build_environment_table(env);
+    const auto st = [](uint32_t y) { return float(std::sin(3.14159265358979 * (y + 0.5) / 4.0)); };
+    const float k = environment_density(t, 0, 1) / (0.75f * 0.75f * st(1)); // the common scale
+    EXPECT_GT(k, 0.0f);
+    EXPECT_NEAR(environment_density(t, 7, 1), k * 0.125f * 0.75f * st(1), 1e-5f) << "u wraps";
+    EXPECT_NEAR(environment_density(t, 1, 1), k * 0.125f * 0.75f * st(1), 1e-5f);
+    EXPECT_NEAR(environment_density(t, 7, 2), k * 0.125f * 0.125f * st(2), 1e-5f);
+    EXPECT_NEAR(environment_density(t, 2, 1), 0.0f, 1e-7f) << "two texels away: untouched";
+    EXPECT_NEAR(environment_density(t, 4, 0), k * 0.75f * (0.75f + 0.125f) * st(0), 1e-5f) << "v clamps at the pole";
+    EXPECT_NEAR(environment_density(t, 4, 1), k * 0.75f * 0.125f * st(1), 1e-5f);
+    double mean = 0.0;
+    for (uint32_t y = 0; y < 4; ++y)
+        for (uint32_t x = 0; x < 8; ++x) mean += environment_density(t, x, y);
+    EXPECT_NEAR(mean / 32.0, 1.0, 1e-5);
+}
+
 TEST(EnvironmentTable, ConstantEnvironmentIsOneTexel) {
     Environment env;
     env.constant = glm::vec3(0.5f);
