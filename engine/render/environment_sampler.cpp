@@ -21,9 +21,9 @@ EnvironmentTable build_environment_table(const Environment& env) {
     t.height = map ? env.height : 1;
     const uint32_t w = t.width, h = t.height;
     const size_t texels = size_t(w) * h;
-    t.data.assign(texels * 3 + (h + 1) + size_t(h) * (w + 1) + texels, 0.0f);
-    for (size_t i = 0; i < texels; ++i)
-        for (int c = 0; c < 3; ++c) t.data[i * 3 + c] = clean(map ? env.rgb[i * 3 + c] : env.constant[c]);
+    t.data.assign(texels * 4 + (h + 1) + size_t(h) * (w + 1) + texels, 0.0f);
+    for (size_t i = 0; i < texels; ++i) // rgba: one 16-byte load per texel in the shader (a unused)
+        for (int c = 0; c < 3; ++c) t.data[i * 4 + c] = clean(map ? env.rgb[i * 3 + c] : env.constant[c]);
 
     // The shader reads the map bilinearly (texel centres at half-integers, u wraps, v clamps), so a texel's
     // share of the samples follows the mean of that bilinear function over the texel: its luminance and
@@ -33,7 +33,7 @@ EnvironmentTable build_environment_table(const Environment& env) {
     // small density: fireflies.
     std::vector<float> lum(texels);
     for (size_t i = 0; i < texels; ++i) {
-        const float* p = t.data.data() + i * 3;
+        const float* p = t.data.data() + i * 4;
         lum[i] = nb_luminance(vec3(p[0], p[1], p[2]));
     }
     const float wk[3] = {0.125f, 0.75f, 0.125f};
@@ -50,7 +50,7 @@ EnvironmentTable build_environment_table(const Environment& env) {
     };
 
     // f = filtered luminance * sin(theta) at row centres; rows in double for long sums.
-    float* marginal = t.data.data() + texels * 3;
+    float* marginal = t.data.data() + texels * 4;
     float* conditional = marginal + (h + 1);
     float* density = conditional + size_t(h) * (w + 1);
     std::vector<double> row_sum(h, 0.0), f(texels, 0.0);
@@ -80,12 +80,13 @@ EnvironmentTable build_environment_table(const Environment& env) {
     t.inv_mean = total > 0.0 ? float(double(texels) / total) : 0.0f;
     // Density in (u, v) of each texel (f / mean f): what the shader's pdf reads (nb_env_texel_density).
     for (size_t i = 0; i < texels; ++i) density[i] = float(f[i] * double(t.inv_mean));
+    t.data.resize((t.data.size() + 3) / 4 * 4, 0.0f); // whole vec4s (the shader's array)
     return t;
 }
 
 float environment_density(const EnvironmentTable& t, uint32_t x, uint32_t y) {
     const size_t texels = size_t(t.width) * t.height;
-    return t.data[texels * 3 + (t.height + 1) + size_t(t.height) * (t.width + 1) + size_t(y) * t.width + x];
+    return t.data[texels * 4 + (t.height + 1) + size_t(t.height) * (t.width + 1) + size_t(y) * t.width + x];
 }
 
 } // namespace nbvh::render

@@ -1,6 +1,6 @@
 // CPU side of environment importance sampling: the piecewise-constant 2D distribution over texels with
 // density proportional to the texel's mean of the bilinearly filtered luminance * sin(theta) (pbrt-v4
-// §12.6), packed the way shaders/lib/env.glsl reads it: rgb texels (w*h*3), marginal row cdf (h+1),
+// §12.6), packed the way shaders/lib/env.glsl reads it: rgba texels (w*h*4), marginal row cdf (h+1),
 // conditional cdfs (h*(w+1)), per-texel densities in (u, v) (w*h).
 #pragma once
 #include <cstdint>

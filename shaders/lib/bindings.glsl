@@ -41,10 +41,11 @@ layout(set = 0, binding = NB_BIND_TEXTURE_INFOS, scalar) readonly buffer Texture
 // the passes that sample textures declare it (and have a texture-array variant, shaders/CMakeLists.txt).
 layout(set = 0, binding = NB_BIND_LIGHTS, scalar) readonly buffer LightBuffer { GpuLight lights[]; };
 layout(set = 0, binding = NB_BIND_LIGHT_CDF, scalar) readonly buffer LightCdfBuffer { float light_cdf[]; };
-// Environment: rgb texels (width*height*3), then the marginal row cdf (height+1), then one conditional
-// cdf per row (height*(width+1)), then the texels' densities (width*height); layout written by
-// engine/render/environment_sampler.cpp.
-layout(set = 0, binding = NB_BIND_ENV, scalar) readonly buffer EnvBuffer { float env_data[]; };
+// Environment: rgba texels (width*height*4, a unused: one 16-byte load per texel), then the marginal row
+// cdf (height+1), then one conditional cdf per row (height*(width+1)), then the texels' densities
+// (width*height); layout written by engine/render/environment_sampler.cpp. Floats are read through
+// nb_env_float (lib/env.glsl).
+layout(set = 0, binding = NB_BIND_ENV, std430) readonly buffer EnvBuffer { vec4 env_data[]; };
 layout(set = 0, binding = NB_BIND_RAYS, scalar) buffer RayBuffer { uint ray_words[]; };
 layout(set = 0, binding = NB_BIND_HITS, scalar) buffer HitBuffer { uint hit_words[]; };
 layout(set = 0, binding = NB_BIND_SHADOW_RAYS, scalar) buffer ShadowBuffer { uint shadow_words[]; };

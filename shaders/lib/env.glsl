@@ -2,19 +2,19 @@
 // at half-integers, u wraps, v clamps): a sky or map seen directly has no texel steps. Directions are drawn
 // piecewise-constant over texels, with densities the CPU built from each texel's mean of that bilinear
 // luminance * sin(theta) (engine/render/environment_sampler.cpp); the pdf is that of the sampling
-// procedure, so NEE and MIS stay unbiased with the filtered radiance. Buffer layout: rgb texels, marginal
+// procedure, so NEE and MIS stay unbiased with the filtered radiance. Buffer layout: rgba texels, marginal
 // cdf, conditional cdfs, densities (bindings.glsl NB_BIND_ENV).
 #ifndef NB_ENV_GLSL
 #define NB_ENV_GLSL
 #include "lib/bindings.glsl"
 #include "shared/sampling.h"
 
-vec3 nb_env_texel(uint x, uint y) {
-    uint i = (y * params.env_width + x) * 3u;
-    return vec3(env_data[i], env_data[i + 1u], env_data[i + 2u]);
-}
+vec3 nb_env_texel(uint x, uint y) { return env_data[y * params.env_width + x].xyz; }
 
-uint nb_env_marginal_base() { return params.env_width * params.env_height * 3u; }
+// Float i of the buffer (the cdfs and densities after the texels).
+float nb_env_float(uint i) { return env_data[i >> 2u][i & 3u]; }
+
+uint nb_env_marginal_base() { return params.env_width * params.env_height * 4u; }
 uint nb_env_conditional_base(uint row) {
     return nb_env_marginal_base() + params.env_height + 1u + row * (params.env_width + 1u);
 }
@@ -22,7 +22,7 @@ uint nb_env_conditional_base(uint row) {
 uint nb_env_density_base() { return nb_env_conditional_base(params.env_height); }
 
 // Density in (u, v) of texel (x, y): f / mean(f), precomputed.
-float nb_env_texel_density(uint x, uint y) { return env_data[nb_env_density_base() + y * params.env_width + x]; }
+float nb_env_texel_density(uint x, uint y) { return nb_env_float(nb_env_density_base() + y * params.env_width + x); }
 
 // Bilinear radiance at (u, v) in [0, 1]^2 (before the intensity).
 vec3 nb_env_bilinear(vec2 uv) {
@@ -62,7 +62,7 @@ uint nb_env_search(uint base, uint n, float u) {
     uint lo = 0u, hi = n - 1u;
     while (lo < hi) {
         uint mid = (lo + hi) / 2u;
-        if (env_data[base + mid + 1u] > u) hi = mid;
+        if (nb_env_float(base + mid + 1u) > u) hi = mid;
         else lo = mid + 1u;
     }
     return lo;
@@ -74,11 +74,11 @@ vec3 nb_env_sample(vec2 u, out vec3 dir, out float pdf) {
     float u2 = u.y;
     uint mb = nb_env_marginal_base();
     uint y = nb_env_search(mb, params.env_height, u1);
-    float c0 = env_data[mb + y], c1 = env_data[mb + y + 1u];
+    float c0 = nb_env_float(mb + y), c1 = nb_env_float(mb + y + 1u);
     float dv = c1 > c0 ? clamp((u1 - c0) / (c1 - c0), 0.0f, 1.0f) : 0.5f;
     uint cb = nb_env_conditional_base(y);
     uint x = nb_env_search(cb, params.env_width, u2);
-    float d0 = env_data[cb + x], d1 = env_data[cb + x + 1u];
+    float d0 = nb_env_float(cb + x), d1 = nb_env_float(cb + x + 1u);
     float du = d1 > d0 ? clamp((u2 - d0) / (d1 - d0), 0.0f, 1.0f) : 0.5f;
     vec2 uv = vec2((float(x) + du) / float(params.env_width), (float(y) + dv) / float(params.env_height));
     dir = nb_env_uv_to_dir(uv, params.env_rotation);

@@ -122,7 +122,7 @@ TEST(EnvironmentTable, CdfsAreMonotoneAndDensityAveragesToOne) {
     for (size_t i = 0; i < env.rgb.size(); ++i) env.rgb[i] = float((i * 7919) % 13) * 0.1f;
     env.rgb[5] = NAN; // bad texel reads as 0
     const EnvironmentTable t = build_environment_table(env);
-    const float* marginal = t.data.data() + 16 * 8 * 3;
+    const float* marginal = t.data.data() + 16 * 8 * 4; // after the rgba texels
     for (uint32_t y = 0; y < 8; ++y) EXPECT_LE(marginal[y], marginal[y + 1]);
     EXPECT_FLOAT_EQ(marginal[8], 1.0f);
     double mean = 0.0;
