@@ -10,10 +10,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "engine/bvh/scene_accel.h"
 #include "engine/render/wavefront.h"
 #include "engine/scene/environment.h"
-#include "engine/vk/context.h"
 #include "shaders/shared/sampling.h"
 #include "tests/render/test_scenes.h"
 
@@ -22,21 +20,15 @@ namespace {
 
 RenderResult render_env(const Scene& scene, const Environment& env, uint32_t spp, uint32_t max_depth, uint32_t size,
                         int& validation) {
-    vk::ContextOptions o;
-    o.device = vk::DeviceChoice::cpu;
-    o.validation = true;
-    vk::Context ctx(o);
-    const SceneAccel accel = build_scene_accel(scene);
     RenderOptions opt;
     opt.width = size;
     opt.height = size;
     opt.spp = spp;
     opt.max_depth = max_depth;
     opt.seed = 5;
-    WavefrontRenderer r(ctx, scene, accel, env, scene.camera, opt);
-    RenderResult out = r.render();
-    validation = ctx.validation_message_count();
-    return out;
+    test::LavapipeRender r = test::render_lavapipe(scene, env, scene.camera, opt);
+    validation = r.validation_enabled ? r.validation : -1;
+    return std::move(r.result);
 }
 
 // The shader's lookup (lib/env.glsl nb_env_bilinear) on the CPU: texel centres at half-integers, u wraps,

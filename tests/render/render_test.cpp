@@ -18,21 +18,11 @@
 namespace nbvh::render {
 namespace {
 
-struct Rendered {
-    RenderResult result;
-    int validation = 0;
-    bool validation_enabled = false;
-    SceneFeatures features;
-};
+using Rendered = test::LavapipeRender;
 
 Rendered render_small(const Scene& scene, const Environment& env, uint32_t spp = 4, uint32_t max_depth = 3,
                       uint32_t seed = 1, uint32_t width = 48, uint32_t height = 32, uint32_t wave_pixels = 1024,
                       bool sort_rays = RenderOptions{}.sort_rays, Sampler sampler = RenderOptions{}.sampler) {
-    vk::ContextOptions o;
-    o.device = vk::DeviceChoice::cpu;
-    o.validation = true;
-    vk::Context ctx(o);
-    const SceneAccel accel = build_scene_accel(scene);
     RenderOptions opt;
     opt.width = width;
     opt.height = height;
@@ -42,14 +32,7 @@ Rendered render_small(const Scene& scene, const Environment& env, uint32_t spp =
     opt.max_wave_pixels = wave_pixels; // 1024 at 48x32: two waves, exercises the wave offsets
     opt.sort_rays = sort_rays;
     opt.sampler = sampler;
-    const Camera cam = scene.has_camera ? scene.camera : auto_frame(scene, 1.5f);
-    WavefrontRenderer r(ctx, scene, accel, env, cam, opt);
-    Rendered out;
-    out.features = r.features();
-    out.result = r.render();
-    out.validation = ctx.validation_message_count();
-    out.validation_enabled = ctx.validation_enabled();
-    return out;
+    return test::render_lavapipe(scene, env, scene.has_camera ? scene.camera : auto_frame(scene, 1.5f), opt);
 }
 
 void expect_sane(const Rendered& r) {

@@ -5,7 +5,26 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "engine/bvh/scene_accel.h"
+#include "engine/vk/context.h"
+
 namespace nbvh::test {
+
+LavapipeRender render_lavapipe(const Scene& scene, const Environment& env, const Camera& camera,
+                               const render::RenderOptions& options) {
+    vk::ContextOptions o;
+    o.device = vk::DeviceChoice::cpu;
+    o.validation = true;
+    vk::Context ctx(o);
+    const SceneAccel accel = build_scene_accel(scene);
+    render::WavefrontRenderer r(ctx, scene, accel, env, camera, options);
+    LavapipeRender out;
+    out.features = r.features();
+    out.result = r.render();
+    out.validation = ctx.validation_message_count();
+    out.validation_enabled = ctx.validation_enabled();
+    return out;
+}
 
 Scene make_quad_scene() {
     Scene s;

@@ -1,8 +1,19 @@
 // Small scenes built in code for the renderer tests.
 #pragma once
+#include "engine/render/wavefront.h"
 #include "engine/scene/scene.h"
 
 namespace nbvh::test {
+
+// One render on lavapipe with the Khronos validation layer on (the renderer tests' set-up).
+struct LavapipeRender {
+    render::RenderResult result;
+    render::SceneFeatures features;
+    int validation = 0;              // validation messages
+    bool validation_enabled = false; // whether the layer was there to count them
+};
+LavapipeRender render_lavapipe(const Scene& scene, const Environment& env, const Camera& camera,
+                               const render::RenderOptions& options);
 
 // A unit quad in the z = 0 plane facing +z (two triangles), one grey material, one instance.
 Scene make_quad_scene();
