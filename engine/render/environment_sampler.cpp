@@ -9,9 +9,34 @@ namespace nbvh::render {
 
 namespace {
 float clean(float v) { return std::isfinite(v) && v > 0.0f ? v : 0.0f; }
+
+// 2x2 box averages (an odd last row or column is averaged with itself), clean values.
+std::vector<float> halve(const std::vector<float>& rgb, uint32_t& w, uint32_t& h) {
+    const uint32_t hw = std::max(1u, w / 2), hh = std::max(1u, h / 2);
+    std::vector<float> out(size_t(hw) * hh * 3, 0.0f);
+    for (uint32_t y = 0; y < hh; ++y)
+        for (uint32_t x = 0; x < hw; ++x)
+            for (int c = 0; c < 3; ++c) {
+                float sum = 0.0f;
+                for (uint32_t dy = 0; dy < 2; ++dy)
+                    for (uint32_t dx = 0; dx < 2; ++dx) {
+                        const uint32_t sx = std::min(w - 1, 2 * x + dx), sy = std::min(h - 1, 2 * y + dy);
+                        sum += clean(rgb[(size_t(sy) * w + sx) * 3 + c]);
+                    }
+                out[(size_t(y) * hw + x) * 3 + c] = 0.25f * sum;
+            }
+    w = hw;
+    h = hh;
+    return out;
+}
 } // namespace
 
-EnvironmentTable build_environment_table(const Environment& env) {
+uint64_t environment_table_bytes(uint32_t w, uint32_t h) {
+    const uint64_t texels = uint64_t(w) * h;
+    return (texels * 4 + (h + 1) + uint64_t(h) * (w + 1) + texels + 3) / 4 * 16;
+}
+
+EnvironmentTable build_environment_table(const Environment& env, uint64_t max_bytes) {
     EnvironmentTable t;
     t.intensity = std::isfinite(env.intensity) ? std::max(env.intensity, 0.0f) : 0.0f;
     t.rotation = std::isfinite(env.rotation) ? env.rotation : 0.0f;
@@ -19,11 +44,17 @@ EnvironmentTable build_environment_table(const Environment& env) {
                      env.rgb.size() >= size_t(env.width) * env.height * 3;
     t.width = map ? env.width : 1;
     t.height = map ? env.height : 1;
+    std::vector<float> halved; // the map after halvings (empty: env.rgb as it is)
+    while (map && environment_table_bytes(t.width, t.height) > max_bytes && (t.width > 1 || t.height > 1)) {
+        halved = halve(halved.empty() ? env.rgb : halved, t.width, t.height);
+        t.halvings++;
+    }
+    const std::vector<float>& rgb = halved.empty() ? env.rgb : halved;
     const uint32_t w = t.width, h = t.height;
     const size_t texels = size_t(w) * h;
     t.data.assign(texels * 4 + (h + 1) + size_t(h) * (w + 1) + texels, 0.0f);
     for (size_t i = 0; i < texels; ++i) // rgba: one 16-byte load per texel in the shader (a unused)
-        for (int c = 0; c < 3; ++c) t.data[i * 4 + c] = clean(map ? env.rgb[i * 3 + c] : env.constant[c]);
+        for (int c = 0; c < 3; ++c) t.data[i * 4 + c] = clean(map ? rgb[i * 3 + c] : env.constant[c]);
 
     // The shader reads the map bilinearly (texel centres at half-integers, u wraps, v clamps), so a texel's
     // share of the samples follows the mean of that bilinear function over the texel: its luminance and

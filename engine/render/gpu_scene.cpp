@@ -278,7 +278,12 @@ GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Envir
     pack_punctual_lights(scene, out);
     if (out.lights.empty()) out.lights.push_back(GpuLight{});
 
-    out.environment = build_environment_table(environment);
+    out.environment = build_environment_table(environment, options.environment_budget_bytes);
+    if (out.environment.halvings > 0)
+        log_info("render: environment map %ux%u halved %u time%s to %ux%u to fit one storage binding (%llu MiB)",
+                 environment.width, environment.height, out.environment.halvings,
+                 out.environment.halvings == 1 ? "" : "s", out.environment.width, out.environment.height,
+                 (unsigned long long)(options.environment_budget_bytes >> 20));
     return out;
 }
 

@@ -42,6 +42,7 @@ struct PackOptions {
     // false: no texel upload (the scene fetches no texel, or the texture-array path holds them as images)
     bool textures = true;
     uint64_t texel_budget_bytes = 96ull << 20;  // below lavapipe's 128 MiB per binding (texture_path.h)
+    uint64_t environment_budget_bytes = UINT64_MAX; // the environment map is halved until its table fits
 };
 
 // `environment` is the one the render uses (scene's, --env, or the default sky).

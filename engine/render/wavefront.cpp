@@ -79,6 +79,7 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     PackOptions pack;
     pack.textures = texture_plan_.path == TexturePath::buffer;
     pack.texel_budget_bytes = texel_budget_bytes(range);
+    pack.environment_budget_bytes = range;
     data_ = pack_scene(scene, accel, environment, pack);
     if (texture_array) {
         texture_array_ = TextureArray(ctx_, scene.textures);

@@ -161,6 +161,34 @@ TEST(EnvironmentTable, DensityIsTheBilinearMeanOfEachTexel) {
     EXPECT_NEAR(mean / 32.0, 1.0, 1e-5);
 }
 
+// A map whose table would not fit one storage binding is halved (2x2 box averages) until it does, instead
+// of failing the render (a 4096x2048 HDRI on lavapipe's 128 MiB binding).
+TEST(EnvironmentTable, LargeMapsAreHalvedToFitTheBinding) {
+    Environment env;
+    env.width = 64;
+    env.height = 32;
+    env.rgb.resize(64 * 32 * 3);
+    for (uint32_t y = 0; y < 32; ++y)
+        for (uint32_t x = 0; x < 64; ++x)
+            for (int c = 0; c < 3; ++c) env.rgb[(size_t(y) * 64 + x) * 3 + c] = float(x + 64 * y + c);
+    const EnvironmentTable full = build_environment_table(env);
+    EXPECT_EQ(full.width, 64u);
+    EXPECT_EQ(full.halvings, 0u);
+    EXPECT_EQ(uint64_t(full.data.size()) * 4, environment_table_bytes(64, 32));
+    const uint64_t budget = environment_table_bytes(16, 8);
+    const EnvironmentTable t = build_environment_table(env, budget);
+    EXPECT_EQ(t.width, 16u);
+    EXPECT_EQ(t.height, 8u);
+    EXPECT_EQ(t.halvings, 2u);
+    EXPECT_LE(uint64_t(t.data.size()) * 4, budget);
+    // Texel (0, 0) is the mean of the source's 4x4 block; channel 0: x + 64 y over x, y in 0..3.
+    EXPECT_NEAR(t.data[0], (1.5f + 64.0f * 1.5f), 1e-3f);
+    double mean = 0.0;
+    for (uint32_t y = 0; y < 8; ++y)
+        for (uint32_t x = 0; x < 16; ++x) mean += environment_density(t, x, y);
+    EXPECT_NEAR(mean / 128.0, 1.0, 1e-5);
+}
+
 TEST(EnvironmentTable, ConstantEnvironmentIsOneTexel) {
     Environment env;
     env.constant = glm::vec3(0.5f);
