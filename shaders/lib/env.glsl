@@ -24,19 +24,14 @@ uint nb_env_density_base() { return nb_env_conditional_base(params.env_height); 
 // Density in (u, v) of texel (x, y): f / mean(f), precomputed.
 float nb_env_texel_density(uint x, uint y) { return nb_env_float(nb_env_density_base() + y * params.env_width + x); }
 
-// Bilinear radiance at (u, v) in [0, 1]^2 (before the intensity).
+// Bilinear radiance at (u, v) in [0, 1]^2 (before the intensity; footprint: shared/sampling.h).
 vec3 nb_env_bilinear(vec2 uv) {
-    float fx = uv.x * float(params.env_width) - 0.5f;
-    float fy = uv.y * float(params.env_height) - 0.5f;
-    float x0f = floor(fx), y0f = floor(fy);
-    float ax = fx - x0f, ay = fy - y0f;
-    int w = int(params.env_width), h = int(params.env_height);
-    int xi = int(x0f);
-    uint x0 = uint(((xi % w) + w) % w), x1 = uint((((xi + 1) % w) + w) % w);
-    uint y0 = uint(clamp(int(y0f), 0, h - 1)), y1 = uint(clamp(int(y0f) + 1, 0, h - 1));
-    vec3 top = mix(nb_env_texel(x0, y0), nb_env_texel(x1, y0), ax);
-    vec3 bottom = mix(nb_env_texel(x0, y1), nb_env_texel(x1, y1), ax);
-    return mix(top, bottom, ay);
+    uvec2 lo, hi;
+    vec2 f;
+    nb_env_bilinear_footprint(uv, params.env_width, params.env_height, lo, hi, f);
+    vec3 top = mix(nb_env_texel(lo.x, lo.y), nb_env_texel(hi.x, lo.y), f.x);
+    vec3 bottom = mix(nb_env_texel(lo.x, hi.y), nb_env_texel(hi.x, hi.y), f.x);
+    return mix(top, bottom, f.y);
 }
 
 void nb_env_texel_of(vec3 dir, out uint x, out uint y, out float sin_theta) {

@@ -202,6 +202,18 @@ NB_FN vec2 nb_env_dir_to_uv(vec3 d, float rotation) {
     return vec2(u - floor(u), v);
 }
 
+// Bilinear footprint of (u, v) in a w x h equirectangular map: texel centres at half-integers, u wraps
+// (the seam), v clamps (the poles). Texels lo/hi per axis, weights f of the hi ones.
+NB_FN void nb_env_bilinear_footprint(vec2 uv, uint w, uint h, NB_OUT(uvec2) lo, NB_OUT(uvec2) hi, NB_OUT(vec2) f) {
+    float fx = uv.x * float(w) - 0.5f;
+    float fy = uv.y * float(h) - 0.5f;
+    float x0f = floor(fx), y0f = floor(fy);
+    f = vec2(fx - x0f, fy - y0f);
+    int iw = int(w), ih = int(h), xi = int(x0f), yi = int(y0f);
+    lo = uvec2(uint(((xi % iw) + iw) % iw), uint(clamp(yi, 0, ih - 1)));
+    hi = uvec2(uint((((xi + 1) % iw) + iw) % iw), uint(clamp(yi + 1, 0, ih - 1)));
+}
+
 NB_FN vec3 nb_env_uv_to_dir(vec2 uv, float rotation) {
     float phi = (uv.x - 0.5f) * 2.0f * NB_PI;
     float theta = uv.y * NB_PI;

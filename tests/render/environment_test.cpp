@@ -31,19 +31,15 @@ RenderResult render_env(const Scene& scene, const Environment& env, uint32_t spp
     return std::move(r.result);
 }
 
-// The shader's lookup (lib/env.glsl nb_env_bilinear) on the CPU: texel centres at half-integers, u wraps,
-// v clamps.
+// The shader's lookup (lib/env.glsl nb_env_bilinear) on the CPU, through the same footprint.
 float bilinear(const Environment& env, glm::vec2 uv, int c) {
-    const int w = int(env.width), h = int(env.height);
-    const float fx = uv.x * float(w) - 0.5f, fy = uv.y * float(h) - 0.5f;
-    const float x0f = std::floor(fx), y0f = std::floor(fy);
-    const float ax = fx - x0f, ay = fy - y0f;
-    const int x0 = ((int(x0f) % w) + w) % w, x1 = ((int(x0f) + 1) % w + w) % w;
-    const int y0 = std::clamp(int(y0f), 0, h - 1), y1 = std::clamp(int(y0f) + 1, 0, h - 1);
-    auto t = [&](int x, int y) { return env.rgb[(size_t(y) * w + x) * 3 + c]; };
-    const float top = t(x0, y0) * (1.0f - ax) + t(x1, y0) * ax;
-    const float bottom = t(x0, y1) * (1.0f - ax) + t(x1, y1) * ax;
-    return top * (1.0f - ay) + bottom * ay;
+    uvec2 lo, hi;
+    vec2 f;
+    nb_env_bilinear_footprint(uv, env.width, env.height, lo, hi, f);
+    auto t = [&](uint32_t x, uint32_t y) { return env.rgb[(size_t(y) * env.width + x) * 3 + c]; };
+    const float top = t(lo.x, lo.y) * (1.0f - f.x) + t(hi.x, lo.y) * f.x;
+    const float bottom = t(lo.x, hi.y) * (1.0f - f.x) + t(hi.x, hi.y) * f.x;
+    return top * (1.0f - f.y) + bottom * f.y;
 }
 
 // A camera at the origin looking down -z sees the sky around u = 0.5, the left edge of texel column 2 of a

@@ -73,6 +73,26 @@ TEST(Sampling, EnvironmentMappingRoundTrips) {
     EXPECT_NEAR(nb_env_dir_to_uv(vec3(0, 1, 0), 0.0f).y, 0.0f, 1e-6f);
 }
 
+// The environment's bilinear footprint (shared/sampling.h, used by lib/env.glsl): texel centres at
+// half-integers, u wrapping across the seam, v clamped at the poles.
+TEST(Sampling, EnvironmentFootprintWrapsUAndClampsV) {
+    uvec2 lo, hi;
+    vec2 f;
+    nb_env_bilinear_footprint(vec2(0.5f, 0.5f), 4, 2, lo, hi, f); // the edge between columns 1 and 2
+    EXPECT_EQ(lo, uvec2(1, 0));
+    EXPECT_EQ(hi, uvec2(2, 1));
+    EXPECT_NEAR(f.x, 0.5f, 1e-6f);
+    EXPECT_NEAR(f.y, 0.5f, 1e-6f);
+    nb_env_bilinear_footprint(vec2(0.01f, 0.1f), 4, 2, lo, hi, f); // left of column 0's centre: wraps to 3
+    EXPECT_EQ(lo, uvec2(3, 0));
+    EXPECT_EQ(hi, uvec2(0, 0)) << "v above the first row's centre clamps to row 0";
+    EXPECT_NEAR(f.x, 0.54f, 1e-5f);
+    nb_env_bilinear_footprint(vec2(0.99f, 0.99f), 4, 2, lo, hi, f); // right of column 3's centre: wraps to 0
+    EXPECT_EQ(lo, uvec2(3, 1));
+    EXPECT_EQ(hi, uvec2(0, 1)) << "v below the last row's centre clamps to the last row";
+    EXPECT_NEAR(f.x, 0.46f, 1e-5f);
+}
+
 TEST(Sampling, RngIsUniformAndSeedDependent) {
     uint a = nb_rng_init(10u, 0u, 1u), b = nb_rng_init(10u, 0u, 2u);
     EXPECT_NE(a, b);
