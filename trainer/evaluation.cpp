@@ -33,7 +33,7 @@ EvalStats evaluate_network(const TrainingAsset& asset, const TrainingCut& cut, c
         // decode rule on top of the same network).
         const glm::vec3 so = o + d * f.t_entry;
         const float len = std::max(f.t_exit - f.t_entry, 0.0f);
-        const GroundTruth gt = trace_ground_truth(asset, so, d, 0.0f, len);
+        const GroundTruth gt = trace_ground_truth(asset, so, d, 0.0f, len, SampleSlot{seed, ~0u, uint32_t(attempt)});
         neural::SegmentQuery q;
         nb_segment_points(asset.encoding, so, d, 0.0f, len, q.points[0], q.points[1], q.points[2]);
         const neural::Outputs y = neural::forward(weights, q, neural::Precision::fp32);

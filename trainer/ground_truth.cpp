@@ -5,15 +5,48 @@
 
 #include "engine/core/error.h"
 #include "shaders/shared/intersect.h"
+#include "shaders/shared/scene_gpu.h"
 #include "engine/neural/asset_table.h"
 #include "engine/scene/texture_sampler.h"
 
 namespace nbvh {
 
+namespace {
+
+// Base-colour uv of a hit (the uv set the material's base-colour texture names); false without uvs.
+bool base_color_uv(const Mesh& m, const Material* material, uint32_t tri, float u, float v, glm::vec2& uv) {
+    const uint32_t uv_set = material ? material->base_color_tex.uv_set : 0u;
+    const std::vector<glm::vec2>& uvs = uv_set == 1u ? m.uv1 : m.uv0;
+    if (uvs.size() != m.positions.size()) return false;
+    const uint32_t* idx = &m.indices[size_t(tri) * 3];
+    uv = (1.0f - u - v) * uvs[idx[0]] + u * uvs[idx[1]] + v * uvs[idx[2]];
+    return true;
+}
+
+const Material* material_of(const TrainingAsset& asset, uint32_t tri) {
+    const Mesh& m = *asset.mesh;
+    const uint32_t mat = tri < m.triangle_material.size() ? m.triangle_material[tri] : 0u;
+    return mat < asset.scene->materials.size() ? &asset.scene->materials[mat] : nullptr;
+}
+
+} // namespace
+
+bool alpha_covers(const TrainingAsset& asset, uint32_t tri, float u, float v, const SampleSlot& key) {
+    const Material* material = material_of(asset, tri);
+    if (!material || material->alpha_mode == AlphaMode::opaque) return true;
+    float alpha = material->base_color.w;
+    glm::vec2 uv;
+    if (material->base_color_tex.texture >= 0 && base_color_uv(*asset.mesh, material, tri, u, v, uv))
+        alpha *= sample_texture_ref(asset.scene->textures, material->base_color_tex, uv, true, glm::vec4(1.0f)).w;
+    return nb_alpha_covers(uint32_t(material->alpha_mode), alpha, material->alpha_cutoff, key.coverage_bits(tri));
+}
+
 bool closest_triangle_hit(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir, float tmin,
-                          float tmax, float& t, uint32_t& triangle, float& u, float& v) {
+                          float tmax, const SampleSlot& key, float& t, uint32_t& triangle, float& u, float& v) {
     Hit hit;
-    if (!intersect_closest(asset.mesh_bvh, Ray{origin, dir}, tmin, tmax, hit)) return false;
+    const HitFilter accept = [&](uint32_t tri, float hu, float hv) { return alpha_covers(asset, tri, hu, hv, key); };
+    if (!intersect_closest(asset.mesh_bvh, Ray{origin, dir}, tmin, tmax, hit, asset.alpha_tested ? &accept : nullptr))
+        return false;
     t = hit.t;
     triangle = hit.triangle;
     u = hit.u;
@@ -64,32 +97,21 @@ glm::vec3 shading_normal(const TrainingAsset& asset, uint32_t tri, float u, floa
 } // namespace
 
 GroundTruth trace_ground_truth(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir,
-                               float t_entry, float t_exit) {
+                               float t_entry, float t_exit, const SampleSlot& key) {
     GroundTruth gt;
     float t, u, v;
     uint32_t tri;
-    if (!closest_triangle_hit(asset, origin, dir, t_entry, t_exit, t, tri, u, v)) return gt;
+    if (!closest_triangle_hit(asset, origin, dir, t_entry, t_exit, key, t, tri, u, v)) return gt;
     gt.hit = true;
     gt.t_hit = t;
     gt.triangle = tri;
     gt.depth = nb_encode_depth_target(asset.encoding, t, t_entry, t_exit, false);
 
-    const Mesh& m = *asset.mesh;
-    const uint32_t* idx = &m.indices[size_t(tri) * 3];
-    const float w = 1.0f - u - v;
-    const uint32_t mat = tri < m.triangle_material.size() ? m.triangle_material[tri] : 0u;
-    const Scene& scene = *asset.scene;
-    const Material* material = mat < scene.materials.size() ? &scene.materials[mat] : nullptr;
+    const Material* material = material_of(asset, tri);
     glm::vec2 uv(0.0f);
-    bool has_uv = false;
-    const uint32_t uv_set = material ? material->base_color_tex.uv_set : 0u;
-    const std::vector<glm::vec2>& uvs = uv_set == 1u ? m.uv1 : m.uv0;
-    if (uvs.size() == m.positions.size()) {
-        uv = w * uvs[idx[0]] + u * uvs[idx[1]] + v * uvs[idx[2]];
-        has_uv = true;
-    }
+    const bool has_uv = base_color_uv(*asset.mesh, material, tri, u, v, uv);
     gt.normal = shading_normal(asset, tri, u, v, uv, has_uv);
-    gt.albedo = learned_albedo(scene, material, uv, has_uv);
+    gt.albedo = learned_albedo(*asset.scene, material, uv, has_uv);
     return gt;
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 #include <glm/glm.hpp>
 
+#include "trainer/pcg32.h"
 #include "trainer/training_asset.h"
 
 namespace nbvh {
@@ -17,11 +18,20 @@ struct GroundTruth {
     uint32_t triangle = 0;
 };
 
-// Closest hit of the asset's triangles with t in [tmin, tmax]. Returns false on a miss.
+// Closest hit of the asset's triangles with t in [tmin, tmax] that its material's alpha keeps
+// (alpha_covers). Returns false on a miss. `key` draws the stochastic coverage of blended surfaces.
 bool closest_triangle_hit(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir, float tmin,
-                          float tmax, float& t, uint32_t& triangle, float& u, float& v);
+                          float tmax, const SampleSlot& key, float& t, uint32_t& triangle, float& u, float& v);
 
+// Whether a hit at barycentrics (u, v) of triangle `tri` (original index) counts: its material's glTF
+// alphaMode with alpha = base-colour factor x texture alpha (shared/scene_gpu.h nb_alpha_covers, the
+// classical traversal's rule); blended surfaces stop a ray with probability alpha, drawn from `key`.
+// Departure from the paper and the official code, whose ground truth has no alpha: without it a
+// cut-out (MASK) or translucent (BLEND) surface is learned opaque.
+bool alpha_covers(const TrainingAsset& asset, uint32_t tri, float u, float v, const SampleSlot& key);
+
+// `key`: the sample's random streams (its slot of the step); only blended surfaces use it.
 GroundTruth trace_ground_truth(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir,
-                               float t_entry, float t_exit);
+                               float t_entry, float t_exit, const SampleSlot& key);
 
 } // namespace nbvh

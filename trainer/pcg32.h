@@ -67,6 +67,12 @@ struct SampleSlot {
         return mix64(seed ^ mix64(((uint64_t(step) << 32) | attempt) ^ mix64(0x9E3779B97F4A7C15ull + slot)));
     }
     NBVH_HOST_DEVICE Pcg32 attempt_rng(uint32_t attempt) const { return Pcg32(attempt_seed(attempt), slot); }
+    // Random bits of triangle `tri`'s stochastic alpha coverage (glTF BLEND, nb_alpha_covers) in this
+    // sample's ground truth: independent per seed, step, slot and triangle (original index), the same
+    // on the CPU and CUDA backends.
+    NBVH_HOST_DEVICE uint32_t coverage_bits(uint32_t tri) const {
+        return uint32_t(mix64(seed ^ mix64(((uint64_t(step) << 32) | tri) ^ mix64(0xC2B2AE3D27D4EB4Full + slot))) >> 32);
+    }
 };
 
 } // namespace nbvh

@@ -169,6 +169,10 @@ TrainingAsset make_training_asset(const Scene& scene, std::span<const uint32_t> 
         a.above_parts[i] = !is_root[i] && (parent == BVH_INVALID || a.above_parts[parent]);
     }
     a.bounds = a.node_boxes[0];
+    // Triangles without a material entry use material 0 (ground_truth.cpp material_of).
+    auto tested = [&](uint32_t mat) { return mat < scene.materials.size() && scene.materials[mat].alpha_mode != AlphaMode::opaque; };
+    a.alpha_tested = a.mesh->triangle_material.size() < a.triangle_count() && tested(0u);
+    for (uint32_t mat : a.mesh->triangle_material) a.alpha_tested = a.alpha_tested || tested(mat);
     // Encoding box: the padded root box; the largest training dilation (1.1e-4 relative, notes §1)
     // keeps encoded points in [0,1]. The map is per axis (anisotropic), as in the official code.
     a.encoding = nb_make_encoding_box(a.bounds.lo, a.bounds.hi);

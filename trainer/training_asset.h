@@ -53,6 +53,7 @@ struct TrainingAsset {
     GpuEncodingBox encoding;            // maps points to [0,1]^3 for the hash grid (neural_query.h)
     float min_extent = 0.0f;            // thin-axis padding (object units)
     float min_exit = 0.0f;              // a leaf segment must end this far in front of the origin
+    bool alpha_tested = false;          // some triangle's material is glTF MASK or BLEND (ground_truth.h)
     uint32_t triangle_count() const { return mesh ? mesh->triangle_count() : 0u; }
 };
 

@@ -57,7 +57,8 @@ namespace {
 
 // Shared by closest and any hit: `any` stops at the first accepted triangle.
 template <bool any>
-bool intersect(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit) {
+bool intersect(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit,
+               const HitFilter* accept = nullptr) {
     bool found = false;
     const glm::vec3* v = mesh.vertices.data();
     const Bvh& bvh = mesh.bvh;
@@ -69,6 +70,7 @@ bool intersect(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit&
                 if (!mesh.single_sided.empty() && mesh.single_sided[k] &&
                     nb_back_facing(v[3 * k], v[3 * k + 1], v[3 * k + 2], ray.dir))
                     continue;
+                if (accept && !(*accept)(bvh.prim_indices[k], u, w)) continue;
                 found = true;
                 t_max = t;
                 hit = Hit{t, bvh.prim_indices[k], u, w};
@@ -82,8 +84,9 @@ bool intersect(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit&
 
 } // namespace
 
-bool intersect_closest(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit) {
-    return intersect<false>(mesh, ray, tmin, tmax, hit);
+bool intersect_closest(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit,
+                       const HitFilter* accept) {
+    return intersect<false>(mesh, ray, tmin, tmax, hit, accept);
 }
 
 bool intersect_any(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax) {

@@ -4,6 +4,7 @@
 // attribute arrays reordered by bvh.prim_indices).
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "engine/bvh/bvh.h"
@@ -37,8 +38,13 @@ BvhBuildOptions default_blas_options();
 
 MeshBvh build_mesh_bvh(const Mesh& mesh, const BvhBuildOptions& options = default_blas_options());
 
-// Closest hit with t in [tmin, tmax]; `hit` is written only when it returns true.
-bool intersect_closest(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit);
+// Which candidate hits count (alpha-tested surfaces): original triangle index and barycentrics.
+using HitFilter = std::function<bool(uint32_t triangle, float u, float v)>;
+
+// Closest hit with t in [tmin, tmax]; `hit` is written only when it returns true. With `accept`, only
+// the hits it accepts.
+bool intersect_closest(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit,
+                       const HitFilter* accept = nullptr);
 // Any hit with t in [tmin, tmax] (shadow rays).
 bool intersect_any(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax);
 

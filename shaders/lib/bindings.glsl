@@ -13,6 +13,7 @@
 #include "shared/wide_bvh_node.h"
 #include "shared/scene_gpu.h"
 #include "shared/wavefront_gpu.h"
+#include "shared/sampling.h"
 
 // Scene features (engine/render/feature_set.h). Disabled features are compiled out of the pipelines
 // by the driver, so a scene without textures never fetches a texel.
@@ -105,6 +106,13 @@ void shadow_store3(uint field, uint i, vec3 v) {
 }
 uint shadow_load1(uint field, uint i) { return shadow_words[nb_shadow_word(field, ray_capacity(), i, 1u)]; }
 void shadow_store1(uint field, uint i, uint v) { shadow_words[nb_shadow_word(field, ray_capacity(), i, 1u)] = v; }
+
+// Random bits of a ray's stochastic alpha coverage (shared/scene_gpu.h nb_alpha_covers): a path ray's
+// are its NB_RAY_RNG word; a shadow ray's come from its path's slot in the wave (pixel, sample, depth).
+uint nb_shadow_alpha_seed(uint slot) {
+    uint pixel = nb_slot_pixel(slot, pc.pixel_offset, pc.pixel_count);
+    return nb_pcg_hash(pixel ^ (pc.depth << 24u) ^ nb_slot_sample(slot, pc.sample_index, pc.pixel_count));
+}
 
 // Ray-sort bin of a ray (shared/wavefront_gpu.h nb_rs_key) in the scene's bounds (the sort header).
 uint nb_rs_bin(vec3 o, vec3 d) {

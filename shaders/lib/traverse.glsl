@@ -74,22 +74,14 @@ NbRayShear g_obj_shear; // nb_ray_shear(g_obj_dir): the per-ray part of the tria
         }                                                                                            \
     }
 
-// g_alpha_seed of a shadow ray from its path's slot in the wave (pixel, sample and depth).
-uint nb_shadow_alpha_seed(uint slot) {
-    uint pixel = nb_slot_pixel(slot, pc.pixel_offset, pc.pixel_count);
-    return nb_pcg_hash(pixel ^ (pc.depth << 24u) ^ nb_slot_sample(slot, pc.sample_index, pc.pixel_count));
-}
-
 // Whether a hit on a triangle counts: alpha masks cut it out; alpha blending is stochastic (the
 // surface is hit with probability alpha), which keeps the estimator unbiased without sorting hits.
 bool nb_alpha_accepts(GpuTriangle tri, vec2 bary) {
     if (!NB_HAS_ALPHA_MASK) return true;
     GpuMaterial m = materials[tri.material];
     if (m.alpha_mode == NB_ALPHA_OPAQUE) return true;
-    float alpha = nb_material_alpha(m, tri, bary);
-    if (m.alpha_mode == NB_ALPHA_MASK) return alpha >= m.alpha_cutoff;
     uint h = nb_pcg_hash(g_alpha_seed ^ nb_pcg_hash(floatBitsToUint(bary.x) + tri.v0));
-    return float(h >> 8u) * (1.0f / 16777216.0f) < alpha;
+    return nb_alpha_covers(m.alpha_mode, nb_material_alpha(m, tri, bary), m.alpha_cutoff, h);
 }
 
 // BLAS leaf: triangles first .. first+count-1 of the current instance's mesh (BLAS leaf order).

@@ -57,6 +57,17 @@ NB_STATIC_ASSERT(sizeof(GpuTexRef) == 32, "GpuTexRef layout");
 #define NB_ALPHA_MASK 1u
 #define NB_ALPHA_BLEND 2u
 
+// Whether a surface of alpha `alpha` (factor x texture) stops a ray, by its glTF alphaMode: MASK where
+// alpha >= cutoff; BLEND with probability alpha (the draw: the high 24 bits of `hash`), which keeps
+// the estimator unbiased without sorting hits; OPAQUE always. One rule for the classical traversal
+// (lib/traverse.glsl), both trainers' ground truth (trainer/ground_truth.cpp, cuda/sampling_kernels.cu)
+// and the neural query of blended assets (lib/neural_query_pass.glsl, alpha = the learned visibility).
+NB_FN bool nb_alpha_covers(uint mode, float alpha, float cutoff, uint hash) {
+    if (mode == NB_ALPHA_MASK) return alpha >= cutoff;
+    if (mode == NB_ALPHA_BLEND) return float(hash >> 8u) * (1.0f / 16777216.0f) < alpha;
+    return true;
+}
+
 // glTF metallic-roughness material (+ transmission). Emissive already includes emissive_strength.
 struct GpuMaterial {
     vec4 base_color;      // linear RGBA factor

@@ -57,7 +57,7 @@ void check_samples(const TrainingAsset& asset, const TrainingCut& cut) {
                 ASSERT_LE(q[a], 1.0f + slack);
             }
         }
-        const GroundTruth gt = trace_ground_truth(asset, s.origin, s.dir, 0.0f, s.length);
+        const GroundTruth gt = trace_ground_truth(asset, s.origin, s.dir, 0.0f, s.length, SampleSlot{});
         ASSERT_TRUE(std::isfinite(gt.depth) && gt.depth >= 0.0f && gt.depth <= 1.0f);
         ASSERT_TRUE(finite3(gt.normal) && finite3(gt.albedo));
         if (gt.hit) {
@@ -125,7 +125,7 @@ TEST(TrainerNumerics, RaysParallelToFacesAndOriginsOnFacesOrInside) {
             ASSERT_TRUE(std::isfinite(f.t_entry) && std::isfinite(f.t_exit) && f.t_exit >= f.t_entry);
             const glm::vec3 so = o + d * f.t_entry;
             const float len = f.t_exit - f.t_entry;
-            const GroundTruth gt = trace_ground_truth(asset, so, d, 0.0f, len);
+            const GroundTruth gt = trace_ground_truth(asset, so, d, 0.0f, len, SampleSlot{});
             ASSERT_TRUE(std::isfinite(gt.depth) && finite3(gt.normal));
             neural::SegmentQuery q;
             nb_segment_points(asset.encoding, so, d, 0.0f, len, q.points[0], q.points[1], q.points[2]);

@@ -69,4 +69,34 @@ inline Mesh cube(float scale = 1.0f, glm::vec3 offset = glm::vec3(0.0f)) {
     return m;
 }
 
+// Alpha-tested surfaces (glTF alphaMode) for the ground-truth tests, one mesh, rays along -z:
+// - triangles 0-1, material 0 (MASK, cutoff 0.5): quad [0,1]^2 at z = 0, uv = xy, base-colour texture
+//   of 2x1 texels with alpha 0 (left) and 255 (right): a hole where x < 0.5;
+// - triangles 2-3, material 1 (BLEND, alpha factor 0.3): quad [1.2,2.2] x [0,1] at z = 0;
+// - triangles 4-5, material 2 (opaque): a backdrop [0,2.2] x [0,1] at z = -0.5.
+inline Scene alpha_quads_scene() {
+    Mesh m;
+    m.name = "alpha_quads";
+    add_quad(m, {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1});
+    add_quad(m, {1.2f, 0, 0}, {2.2f, 0, 0}, {2.2f, 1, 0}, {1.2f, 1, 0}, {0, 0, 1});
+    add_quad(m, {0, 0, -0.5f}, {2.2f, 0, -0.5f}, {2.2f, 1, -0.5f}, {0, 1, -0.5f}, {0, 0, 1});
+    for (size_t i = 0; i < m.positions.size(); ++i) m.uv0.push_back(glm::vec2(m.positions[i]));
+    Scene s = scene_of(m);
+    s.meshes[0].triangle_material = {0, 0, 1, 1, 2, 2};
+    Texture t;
+    t.width = 2;
+    t.height = 1;
+    t.rgba8 = {200, 200, 200, 0, 200, 200, 200, 255};
+    t.srgb = true;
+    s.textures.push_back(t);
+    Material mask = s.materials[0], blend = s.materials[0], opaque = s.materials[0];
+    mask.alpha_mode = AlphaMode::mask;
+    mask.alpha_cutoff = 0.5f;
+    mask.base_color_tex.texture = 0;
+    blend.alpha_mode = AlphaMode::blend;
+    blend.base_color.w = 0.3f;
+    s.materials = {mask, blend, opaque};
+    return s;
+}
+
 } // namespace nbvh::test

@@ -114,7 +114,7 @@ TEST(GroundTruth, QuadHitDepthNormalAlbedo) {
     const Scene scene = test::scene_of(m, glm::vec3(0.25f, 0.5f, 0.75f));
     const TrainingAsset asset = make_training_asset(scene, 0);
     // Segment from z = 1 to z = -1 through (0.3, 0.6): hit at t = 1 of a length-2 segment.
-    const GroundTruth gt = trace_ground_truth(asset, {0.3f, 0.6f, 1.0f}, {0, 0, -1}, 0.0f, 2.0f);
+    const GroundTruth gt = trace_ground_truth(asset, {0.3f, 0.6f, 1.0f}, {0, 0, -1}, 0.0f, 2.0f, SampleSlot{});
     ASSERT_TRUE(gt.hit);
     EXPECT_NEAR(gt.t_hit, 1.0f, 1e-6f);
     EXPECT_NEAR(gt.depth, 1.0f / (2.0f + asset.encoding.depth_pad), 1e-6f);
@@ -122,13 +122,13 @@ TEST(GroundTruth, QuadHitDepthNormalAlbedo) {
     EXPECT_NEAR(gt.albedo.x, 0.25f, 1e-6f);
     EXPECT_NEAR(gt.albedo.z, 0.75f, 1e-6f);
     // From below: same normal (never flipped).
-    const GroundTruth below = trace_ground_truth(asset, {0.3f, 0.6f, -1.0f}, {0, 0, 1}, 0.0f, 2.0f);
+    const GroundTruth below = trace_ground_truth(asset, {0.3f, 0.6f, -1.0f}, {0, 0, 1}, 0.0f, 2.0f, SampleSlot{});
     ASSERT_TRUE(below.hit);
     EXPECT_NEAR(below.normal.z, 1.0f, 1e-6f);
     // Segment that stops before the surface: miss.
-    EXPECT_FALSE(trace_ground_truth(asset, {0.3f, 0.6f, 1.0f}, {0, 0, -1}, 0.0f, 0.5f).hit);
+    EXPECT_FALSE(trace_ground_truth(asset, {0.3f, 0.6f, 1.0f}, {0, 0, -1}, 0.0f, 0.5f, SampleSlot{}).hit);
     // Segment starting behind the origin (t_entry < 0) finds the surface behind it.
-    EXPECT_TRUE(trace_ground_truth(asset, {0.3f, 0.6f, -0.5f}, {0, 0, -1}, -1.0f, 0.2f).hit);
+    EXPECT_TRUE(trace_ground_truth(asset, {0.3f, 0.6f, -0.5f}, {0, 0, -1}, -1.0f, 0.2f, SampleSlot{}).hit);
 }
 
 TEST(GroundTruth, TexturedAlbedoIsSrgbDecoded) {
@@ -144,7 +144,7 @@ TEST(GroundTruth, TexturedAlbedoIsSrgbDecoded) {
     scene.materials[0].base_color = glm::vec4(0.5f, 1.0f, 1.0f, 1.0f);
     scene.materials[0].base_color_tex.texture = 0;
     const TrainingAsset asset = make_training_asset(scene, 0);
-    const GroundTruth gt = trace_ground_truth(asset, {0.3f, 0.6f, 1.0f}, {0, 0, -1}, 0.0f, 2.0f);
+    const GroundTruth gt = trace_ground_truth(asset, {0.3f, 0.6f, 1.0f}, {0, 0, -1}, 0.0f, 2.0f, SampleSlot{});
     ASSERT_TRUE(gt.hit);
     EXPECT_NEAR(gt.albedo.y, 0.5029f, 2e-3f);
     EXPECT_NEAR(gt.albedo.x, 0.5f * 0.5029f, 2e-3f); // factor x texture

@@ -119,7 +119,8 @@ public:
                     const TrainingSample s = draw_training_sample(asset_, params.cuts, {params.seed, params.step, i},
                                                                   ts.leaf_draws.data(), ts.draws);
                     if (s.leaf < 0) continue; // starved (no reachable leaf): counted as not trained
-                    const GroundTruth gt = trace_ground_truth(asset_, s.origin, s.dir, 0.0f, s.length);
+                    const GroundTruth gt = trace_ground_truth(asset_, s.origin, s.dir, 0.0f, s.length,
+                                                              SampleSlot{params.seed, params.step, i});
                     nb_segment_points(asset_.encoding, s.origin, s.dir, 0.0f, s.length, queries[n].points[0],
                                       queries[n].points[1], queries[n].points[2]);
                     meta[n] = {neural::make_targets(gt.hit, gt.depth, gt.normal, gt.albedo), gt.hit, s.cut, s.leaf};

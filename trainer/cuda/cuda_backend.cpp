@@ -75,6 +75,12 @@ cuda::CoreAsset flatten_asset(const TrainingAsset& asset) {
             size_t(material->base_color_tex.texture) < scene.textures.size())
             dev_tex = texture_slot(uint32_t(material->base_color_tex.texture));
         a.tri_texture[k] = dev_tex;
+        if (asset.alpha_tested) {
+            const bool tested = material && material->alpha_mode != AlphaMode::opaque;
+            a.tri_coverage.push_back(cuda::TriCoverage{tested ? uint32_t(material->alpha_mode) : 0u, tri,
+                                                 tested ? material->base_color.w : 1.0f,
+                                                 tested ? material->alpha_cutoff : 0.0f});
+        }
         for (int c = 0; c < 3; ++c) {
             const glm::vec3 p = mb.vertices[size_t(k) * 3 + c];
             const glm::vec3 n = has_normals ? m.normals[idx[c]] : glm::vec3(0.0f);

@@ -164,6 +164,10 @@ public:
         tex_info_.upload(a.texture_info.empty() ? std::vector<uint32_t>{0u, 1u, 1u} : a.texture_info);
         srgb_.upload(a.srgb_table.data(), a.srgb_table.size());
         tri_g_.upload(a.tri_geo_normal);
+        if (!a.tri_coverage.empty()) {
+            coverage_.upload(a.tri_coverage);
+            da_.coverage = coverage_.p;
+        }
         da_.mesh_nodes = a.mesh_nodes.empty() ? nullptr : mesh_nodes_.p;
         da_.tri_v = tri_v_.p; da_.tri_n = tri_n_.p; da_.tri_a = tri_a_.p; da_.tri_g = tri_g_.p;
         da_.tri_uv = tri_uv_.p; da_.tri_tex = tri_tex_.p; da_.texels = texels_.p; da_.tex_info = tex_info_.p;
@@ -427,7 +431,7 @@ private:
         if (st == stream_) record(0);
         launch_sample(da_, dc, b.batch, n, seed, step, b.draws(), b.valid(), st);
         if (st == stream_) record(1);
-        launch_ground_truth(da_, b.batch, st);
+        launch_ground_truth(da_, b.batch, seed, step, st);
         if (st == stream_) record(2);
         NBVH_CUDA_CHECK(cudaEventRecord(b.ready, st));
         b.step = step;
@@ -457,6 +461,7 @@ private:
     DevBuf<float> tri_v_, tri_n_, tri_a_, tri_g_, part_boxes_, tri_uv_, srgb_;
     DevBuf<uint32_t> texels_, tex_info_;
     DevBuf<int32_t> tri_tex_;
+    DevBuf<TriCoverage> coverage_;
     DevBuf<GpuBvhNode> mesh_nodes_;
     DevBuf<float> grid_w_, grid_m_, grid_v_, grid_grad_, mlp_w_, mlp_m_, mlp_v_, mlp_grad_, slices_;
     DevBuf<uint32_t> grid_t_, mlp_t_, leaf_samples_, flag_;

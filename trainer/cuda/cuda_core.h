@@ -15,6 +15,14 @@
 
 namespace nbvh::cuda {
 
+// Alpha coverage of one triangle of an alpha-tested asset (trainer/ground_truth.h alpha_covers).
+struct TriCoverage {
+    uint32_t mode;     // NB_ALPHA_* of its material
+    uint32_t triangle; // original index: the key of its coverage draw, as on the CPU
+    float factor;      // base-colour alpha factor (times the texture's alpha where tri_texture has one)
+    float cutoff;      // MASK threshold
+};
+
 // Everything about the asset the GPU needs, in flat host arrays (uploaded once, except the base BVH).
 struct CoreAsset {
     // Base BVH of the N-BVH cut (CPU node order): regularised boxes (lo xyz, hi xyz) and children
@@ -33,6 +41,7 @@ struct CoreAsset {
     std::vector<uint32_t> texture_info; // 3 per texture: first texel, width, height
     std::array<float, 256> srgb_table{}; // engine/core/image.h srgb_to_linear(i / 255), as the CPU sampler
     std::vector<float> tri_geo_normal;  // 3 per triangle: unit geometric normal (fallback)
+    std::vector<TriCoverage> tri_coverage; // per triangle (leaf order); empty: every triangle opaque
     GpuEncodingBox encoding;
     // Parts of a multi-asset run (trainer/training_asset.h TrainingPart): sampling box (lo xyz, extent
     // xyz) and base-BVH root per part; at least one.

@@ -14,6 +14,7 @@
 #include "shaders/shared/mlp.h"
 #include "shaders/shared/neural_query.h"
 #include "engine/neural/shared/training_loss.h"
+#include "trainer/cuda/cuda_core.h"
 #include "trainer/cuda/cut_tree.h"
 #include "trainer/pcg32.h"
 
@@ -38,6 +39,7 @@ struct DevAsset {
     const uint32_t* tex_info = nullptr;  // 3 per texture: first texel, width, height
     const float* srgb = nullptr;         // 256 entries
     const float* tri_g = nullptr;        // 3 per triangle
+    const TriCoverage* coverage = nullptr; // per triangle; null: every triangle opaque
     GpuEncodingBox enc;
     const float* part_boxes = nullptr;    // 6 per part: sampling box lo xyz, extent xyz
     uint32_t parts = 1;
@@ -88,7 +90,8 @@ struct DevNetwork {
 // Launchers (sampling_kernels.cu, network_kernels.cu).
 void launch_sample(const DevAsset& a, const DevCuts& c, const DevBatch& b, uint32_t batch, uint64_t seed,
                    uint32_t step, unsigned long long* draws, uint32_t* valid, cudaStream_t s);
-void launch_ground_truth(const DevAsset& a, const DevBatch& b, cudaStream_t s);
+// `seed`, `step`: the batch's (SampleSlot), for the stochastic coverage of blended surfaces.
+void launch_ground_truth(const DevAsset& a, const DevBatch& b, uint64_t seed, uint32_t step, cudaStream_t s);
 void launch_encode(const DevNetwork& net, const DevBatch& b, cudaStream_t s);
 struct LossParams {
     GpuLossConfig loss; // the composite loss (engine/neural/shared/training_loss.h)

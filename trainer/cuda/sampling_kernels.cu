@@ -5,6 +5,7 @@
 // Compiled with --fmad=false (CMakeLists.txt) so the ray set matches the CPU backend's for a seed.
 #include "trainer/cuda/clip_box.cuh"
 #include "trainer/cuda/device_common.cuh"
+#include "shaders/shared/scene_gpu.h"
 
 namespace nbvh::cuda {
 namespace {
@@ -198,9 +199,56 @@ __global__ void k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint
 
 __device__ vec3 load3(const float* p) { return vec3(p[0], p[1], p[2]); }
 
-// Closest hit in [tmin, tmax] over the GpuBvhNode tree (nearest child first).
-__device__ bool closest_hit(const DevAsset& a, vec3 o, vec3 d, float tmin, float tmax, float& t, uint32_t& tri,
-                            float& u, float& v) {
+// The texel footprint of a bilinear lookup at (u, v): engine/scene/texture_sampler.cpp
+// sample_texture_bilinear (texel centres at +0.5, REPEAT wrap).
+struct Footprint {
+    uint32_t i00, i10, i01, i11; // texel indices
+    float ax, ay;                // weights of the second column / row
+};
+__device__ Footprint footprint(const DevAsset& a, int32_t tex, float u, float v) {
+    const uint32_t first = a.tex_info[3 * tex], w = a.tex_info[3 * tex + 1], h = a.tex_info[3 * tex + 2];
+    if (!isfinite(u) || !isfinite(v)) u = v = 0.0f;
+    u -= floorf(u);
+    v -= floorf(v);
+    const float x = u * float(w) - 0.5f, y = v * float(h) - 0.5f;
+    const float fx = floorf(x), fy = floorf(y);
+    auto wrap = [](int i, int n) { const int m = i % n; return m < 0 ? m + n : m; };
+    const int x0 = wrap(int(fx), int(w)), y0 = wrap(int(fy), int(h));
+    const int x1 = wrap(x0 + 1, int(w)), y1 = wrap(y0 + 1, int(h));
+    const uint32_t r0 = first + uint32_t(y0) * w, r1 = first + uint32_t(y1) * w;
+    return Footprint{r0 + uint32_t(x0), r0 + uint32_t(x1), r1 + uint32_t(x0), r1 + uint32_t(x1), x - fx, y - fy};
+}
+
+// Interpolated base-colour uv of triangle p (leaf order) at barycentrics (u, v).
+__device__ void triangle_uv(const DevAsset& a, uint32_t p, float u, float v, float& uu, float& vv) {
+    const float* tu = a.tri_uv + size_t(p) * 6;
+    const float w = 1.0f - u - v;
+    uu = tu[0] * w + tu[2] * u + tu[4] * v;
+    vv = tu[1] * w + tu[3] * u + tu[5] * v;
+}
+
+// trainer/ground_truth.cpp alpha_covers for triangle p (leaf order): factor x the texture's alpha
+// (bilinear, as the CPU sampler), the shared rule and the same draw.
+__device__ bool covers(const DevAsset& a, uint32_t p, float u, float v, const SampleSlot& key) {
+    const TriCoverage c = a.coverage[p];
+    if (c.mode == NB_ALPHA_OPAQUE) return true;
+    float alpha = c.factor;
+    const int32_t tex = a.tri_tex[p];
+    if (tex >= 0) {
+        float uu, vv;
+        triangle_uv(a, p, u, v, uu, vv);
+        const Footprint f = footprint(a, tex, uu, vv);
+        auto al = [&](uint32_t i) { return float(a.texels[i] >> 24) / 255.0f; };
+        const float top = al(f.i00) * (1.0f - f.ax) + al(f.i10) * f.ax;
+        const float bottom = al(f.i01) * (1.0f - f.ax) + al(f.i11) * f.ax;
+        alpha *= top * (1.0f - f.ay) + bottom * f.ay;
+    }
+    return nb_alpha_covers(c.mode, alpha, c.cutoff, key.coverage_bits(c.triangle));
+}
+
+// Closest hit in [tmin, tmax] over the GpuBvhNode tree (nearest child first) that alpha keeps.
+__device__ bool closest_hit(const DevAsset& a, vec3 o, vec3 d, float tmin, float tmax, const SampleSlot& key,
+                            float& t, uint32_t& tri, float& u, float& v) {
     const vec3 inv = nb_safe_inv_dir(d);
     uint32_t stack[NB_BVH_MAX_DEPTH + 2];
     int top = 0;
@@ -227,7 +275,8 @@ __device__ bool closest_hit(const DevAsset& a, vec3 o, vec3 d, float tmin, float
                 for (uint32_t p = first; p < first + count; ++p) {
                     const float* tv = a.tri_v + size_t(p) * 9;
                     float tt, uu, vv;
-                    if (nb_intersect_triangle(o, d, load3(tv), load3(tv + 3), load3(tv + 6), tmin, best, tt, uu, vv)) {
+                    if (nb_intersect_triangle(o, d, load3(tv), load3(tv + 3), load3(tv + 6), tmin, best, tt, uu, vv) &&
+                        (!a.coverage || covers(a, p, uu, vv, key))) {
                         best = tt; t = tt; u = uu; v = vv; tri = p; hit = true;
                     }
                 }
@@ -253,27 +302,18 @@ __device__ bool closest_hit(const DevAsset& a, vec3 o, vec3 d, float tmin, float
 // engine/scene/texture_sampler.cpp sample_texture_bilinear with srgb = true, RGB only (same float
 // operations: sRGB decoded per texel through the same table, then filtered; REPEAT wrap).
 __device__ vec3 sample_base_colour(const DevAsset& a, int32_t tex, float u, float v) {
-    const uint32_t first = a.tex_info[3 * tex], w = a.tex_info[3 * tex + 1], h = a.tex_info[3 * tex + 2];
-    if (!isfinite(u) || !isfinite(v)) u = v = 0.0f;
-    u -= floorf(u);
-    v -= floorf(v);
-    const float x = u * float(w) - 0.5f, y = v * float(h) - 0.5f;
-    const float fx = floorf(x), fy = floorf(y);
-    const float ax = x - fx, ay = y - fy;
-    auto wrap = [](int i, int n) { const int m = i % n; return m < 0 ? m + n : m; };
-    const int x0 = wrap(int(fx), int(w)), y0 = wrap(int(fy), int(h));
-    const int x1 = wrap(x0 + 1, int(w)), y1 = wrap(y0 + 1, int(h));
-    auto texel = [&](int tx, int ty) {
-        const uint32_t c = a.texels[first + uint32_t(ty) * w + uint32_t(tx)];
+    const Footprint f = footprint(a, tex, u, v);
+    auto texel = [&](uint32_t i) {
+        const uint32_t c = a.texels[i];
         return vec3(a.srgb[c & 0xFFu], a.srgb[(c >> 8) & 0xFFu], a.srgb[(c >> 16) & 0xFFu]);
     };
     // glm::mix(p, q, t) = p * (1 - t) + q * t
-    const vec3 top = texel(x0, y0) * (1.0f - ax) + texel(x1, y0) * ax;
-    const vec3 bottom = texel(x0, y1) * (1.0f - ax) + texel(x1, y1) * ax;
-    return top * (1.0f - ay) + bottom * ay;
+    const vec3 top = texel(f.i00) * (1.0f - f.ax) + texel(f.i10) * f.ax;
+    const vec3 bottom = texel(f.i01) * (1.0f - f.ax) + texel(f.i11) * f.ax;
+    return top * (1.0f - f.ay) + bottom * f.ay;
 }
 
-__global__ void k_ground_truth(DevAsset a, DevBatch b) {
+__global__ void k_ground_truth(DevAsset a, DevBatch b, uint64_t seed, uint32_t step) {
     const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= b.n) return;
     float tg[8] = {0, 0, 0, 0, 0, 0, 0, 0};
@@ -283,7 +323,7 @@ __global__ void k_ground_truth(DevAsset a, DevBatch b) {
     if (b.leaf[i] >= 0) {
         float t = 0.0f, u = 0.0f, v = 0.0f;
         uint32_t tri = 0;
-        if (a.mesh_nodes && closest_hit(a, o, d, 0.0f, len, t, tri, u, v)) {
+        if (a.mesh_nodes && closest_hit(a, o, d, 0.0f, len, SampleSlot{seed, step, i}, t, tri, u, v)) {
             const float w = 1.0f - u - v;
             const float* tn = a.tri_n + size_t(tri) * 9;
             vec3 n = load3(tn) * w + load3(tn + 3) * u + load3(tn + 6) * v;
@@ -293,8 +333,8 @@ __global__ void k_ground_truth(DevAsset a, DevBatch b) {
             vec3 al = load3(ta) * w + load3(ta + 3) * u + load3(ta + 6) * v;
             const int32_t tex = a.tri_tex[tri];
             if (tex >= 0) {
-                const float* tu = a.tri_uv + size_t(tri) * 6;
-                const float uu = tu[0] * w + tu[2] * u + tu[4] * v, vv = tu[1] * w + tu[3] * u + tu[5] * v;
+                float uu, vv;
+                triangle_uv(a, tri, u, v, uu, vv);
                 const vec3 c = sample_base_colour(a, tex, uu, vv);
                 al = vec3(al.x * c.x, al.y * c.y, al.z * c.z);
             }
@@ -321,8 +361,8 @@ void launch_sample(const DevAsset& a, const DevCuts& c, const DevBatch& b, uint3
     NBVH_CUDA_CHECK(cudaGetLastError());
 }
 
-void launch_ground_truth(const DevAsset& a, const DevBatch& b, cudaStream_t s) {
-    k_ground_truth<<<(b.n + 127) / 128, 128, 0, s>>>(a, b);
+void launch_ground_truth(const DevAsset& a, const DevBatch& b, uint64_t seed, uint32_t step, cudaStream_t s) {
+    k_ground_truth<<<(b.n + 127) / 128, 128, 0, s>>>(a, b, seed, step);
     NBVH_CUDA_CHECK(cudaGetLastError());
 }
 
