@@ -68,6 +68,25 @@ NB_FN bool nb_alpha_covers(uint mode, float alpha, float cutoff, uint hash) {
     return true;
 }
 
+// glTF tangent-space normal mapping of the unit vertex normal n: t4 the interpolated tangent (xyz; w
+// the handedness), texel the normal texture's rgb in [0,1], scale the material's normalTexture.scale.
+// The tangent is made orthogonal to n (Gram-Schmidt), b = cross(n, t) * sign(w), and the result is
+// tn.x t + tn.y b + tn.z n normalised (tn = 2 texel - 1, xy scaled). n itself where the tangent or
+// the result degenerates (no tangents: zero). Both trainers' ground truth (trainer/ground_truth.cpp,
+// trainer/cuda/sampling_kernels.cu); the classical shade pass (lib/material.glsl) maps in world space
+// and falls back to an arbitrary frame without tangents, as the official implementation does.
+NB_FN vec3 nb_normal_map(vec3 n, vec4 t4, vec3 texel, float scale) {
+    vec3 t = vec3(t4.x, t4.y, t4.z);
+    t = t - n * dot(n, t);
+    float tl = length(t);
+    if (!(tl > 1.0e-12f) || !(tl < 3.0e38f)) return n;
+    t = t / tl;
+    vec3 b = cross(n, t) * (t4.w < 0.0f ? -1.0f : 1.0f);
+    vec3 m = t * ((texel.x * 2.0f - 1.0f) * scale) + b * ((texel.y * 2.0f - 1.0f) * scale) + n * (texel.z * 2.0f - 1.0f);
+    float ml = length(m);
+    return (ml > 1.0e-12f && ml < 3.0e38f) ? m / ml : n;
+}
+
 // glTF metallic-roughness material (+ transmission). Emissive already includes emissive_strength.
 struct GpuMaterial {
     vec4 base_color;      // linear RGBA factor

@@ -166,6 +166,28 @@ TEST(CudaBackend, FastModeGradientsMatchCpuReference) {
     check_against_cpu(false, 4090);
 }
 
+// One deterministic step on `scene`'s asset; the GPU's rays and ground truth against the CPU's
+// (check_rays_and_truth). Returns the samples and the step's parameters.
+std::vector<CudaDebugSample> step_and_check(const TrainingAsset& asset, StepParams& p) {
+    TrainingCut cut = cut_at_depth(asset, 2);
+    CudaBackendOptions opt;
+    opt.deterministic = true;
+    auto gpu = make_cuda_backend_ex(asset, NeuralConfig{.log2_hash_size = 12}, neural::AdamConfig{}, opt, 7);
+    p.step = 3;
+    p.batch_size = 8192;
+    p.seed = 99;
+    p.cuts = {&cut};
+    p.cut_version = 1;
+    const StepStats st = gpu->step(p);
+    EXPECT_FALSE(st.skipped) << st.skip_reason;
+    std::vector<CudaDebugSample> samples;
+    std::vector<float> mlp_grad, grid_grad;
+    gpu->read_last_step(samples, mlp_grad, grid_grad);
+    check_rays_and_truth(asset, p, st, samples); // <= 1 in 500 samples may differ
+    p.cuts.clear();
+    return samples;
+}
+
 // Alpha-tested surfaces (trainer/ground_truth.h alpha_covers): the GPU's ground truth cuts MASK holes
 // and draws BLEND coverage exactly as the CPU's, sample by sample (same key, same draw).
 TEST(CudaBackend, AlphaCoverageGroundTruthMatchesTheCpu) {
@@ -173,23 +195,9 @@ TEST(CudaBackend, AlphaCoverageGroundTruthMatchesTheCpu) {
     const Scene scene = test::alpha_quads_scene();
     const TrainingAsset asset = make_training_asset(scene, 0);
     ASSERT_TRUE(asset.alpha_tested);
-    TrainingCut cut = cut_at_depth(asset, 2);
-    CudaBackendOptions opt;
-    opt.deterministic = true;
-    auto gpu = make_cuda_backend_ex(asset, NeuralConfig{.log2_hash_size = 12}, neural::AdamConfig{}, opt, 7);
     StepParams p;
-    p.step = 3;
-    p.batch_size = 8192;
-    p.seed = 99;
-    p.cuts = {&cut};
-    p.cut_version = 1;
-    const StepStats st = gpu->step(p);
-    ASSERT_FALSE(st.skipped) << st.skip_reason;
-    std::vector<CudaDebugSample> samples;
-    std::vector<float> mlp_grad, grid_grad;
-    gpu->read_last_step(samples, mlp_grad, grid_grad);
-    check_rays_and_truth(asset, p, st, samples); // <= 1 in 500 samples may differ
-    // Enough samples where alpha decides for a GPU that ignored it to fail the check above.
+    const std::vector<CudaDebugSample> samples = step_and_check(asset, p);
+    // Enough samples where alpha decides for a GPU that ignored it to fail the check.
     Scene opaque_scene = scene;
     for (Material& m : opaque_scene.materials) m.alpha_mode = AlphaMode::opaque;
     const TrainingAsset opaque = make_training_asset(opaque_scene, 0);
@@ -204,6 +212,31 @@ TEST(CudaBackend, AlphaCoverageGroundTruthMatchesTheCpu) {
     }
     std::printf("samples where alpha decides: %u of %u\n", decided, p.batch_size);
     EXPECT_GT(decided, p.batch_size / 50);
+}
+
+// Normal maps (trainer/ground_truth.cpp shading_normal, shared/scene_gpu.h nb_normal_map): the GPU's
+// ground-truth normals match the CPU's (own uv set, texture transform, handedness, scale), and the map
+// moves enough of them for a GPU that ignored it to fail.
+TEST(CudaBackend, NormalMapGroundTruthMatchesTheCpu) {
+    REQUIRE_GPU();
+    const Scene scene = test::normal_mapped_scene();
+    const TrainingAsset asset = make_training_asset(scene, 0);
+    StepParams p;
+    const std::vector<CudaDebugSample> samples = step_and_check(asset, p);
+    Scene plain_scene = scene;
+    plain_scene.materials[0].normal_tex.texture = -1;
+    const TrainingAsset plain = make_training_asset(plain_scene, 0);
+    uint32_t moved = 0;
+    for (uint32_t i = 0; i < uint32_t(samples.size()); ++i) {
+        const CudaDebugSample& s = samples[i];
+        if (s.leaf < 0) continue;
+        const SampleSlot key{p.seed, p.step, i};
+        const GroundTruth a = trace_ground_truth(asset, s.origin, s.dir, 0.0f, s.length, key);
+        const GroundTruth o = trace_ground_truth(plain, s.origin, s.dir, 0.0f, s.length, key);
+        moved += a.hit && glm::dot(a.normal, o.normal) < 0.99f;
+    }
+    std::printf("samples whose normal the map moves: %u of %u\n", moved, p.batch_size);
+    EXPECT_GT(moved, p.batch_size / 50);
 }
 
 TEST(CudaBackend, DeterministicModeIsBitReproducible) {

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "shaders/shared/neural_query.h"
+#include "shaders/shared/scene_gpu.h"
 #include "tests/trainer/trainer_test_scenes.h"
 #include "trainer/cpu/cpu_backend.h"
 #include "trainer/ground_truth.h"
@@ -133,4 +134,38 @@ TEST(TrainerNumerics, RaysParallelToFacesAndOriginsOnFacesOrInside) {
             for (float v : y) ASSERT_TRUE(std::isfinite(v));
         }
     EXPECT_GE(met, 18u);
+}
+
+// The ground truth's shared surface rules at their edges (shared/scene_gpu.h): normal mapping with
+// degenerate, parallel, huge or non-finite tangents and extreme texels stays a unit vector (or the
+// vertex normal); alpha coverage with alpha 0, 1, above 1 and NaN decides without surprises.
+TEST(Numerics, NormalMapAndAlphaCoverageAtTheirEdges) {
+    const glm::vec3 n(0.0f, 0.0f, 1.0f), texel(0.9f, 0.2f, 0.6f);
+    const float inf = INFINITY, nan = std::nanf("");
+    for (const glm::vec4& t4 : {glm::vec4(0.0f), glm::vec4(0.0f, 0.0f, 1.0f, 1.0f), glm::vec4(0.0f, 0.0f, -3.0f, -1.0f),
+                                glm::vec4(1e-20f, 0.0f, 0.0f, 1.0f), glm::vec4(nan, 0.0f, 0.0f, 1.0f),
+                                glm::vec4(inf, 0.0f, 0.0f, 1.0f)}) {
+        const glm::vec3 r = nb_normal_map(n, t4, texel, 1.0f);
+        EXPECT_EQ(r, n) << t4.x << " " << t4.z; // no usable tangent: the vertex normal
+    }
+    for (const glm::vec4& t4 : {glm::vec4(1.0f, 0.0f, 0.0f, 1.0f), glm::vec4(1e30f, 0.0f, 1e30f, -1.0f),
+                                glm::vec4(1e-10f, 1e-10f, 0.0f, 1.0f)})
+        for (const glm::vec3& tx : {glm::vec3(0.0f), glm::vec3(1.0f), glm::vec3(0.5f, 0.5f, 0.0f), texel})
+            for (float scale : {0.0f, 1.0f, 1e30f}) {
+                const glm::vec3 r = nb_normal_map(n, t4, tx, scale);
+                ASSERT_TRUE(finite3(r));
+                EXPECT_NEAR(glm::length(r), 1.0f, 1e-5f);
+            }
+    // tn = 0 (texel 0.5, 0.5, 0.5): no direction; the vertex normal.
+    EXPECT_EQ(nb_normal_map(n, glm::vec4(1.0f, 0.0f, 0.0f, 1.0f), glm::vec3(0.5f), 1.0f), n);
+
+    const uint32_t lo = 0u, hi = 0xFFFFFFFFu; // the smallest and largest draws
+    EXPECT_FALSE(nb_alpha_covers(NB_ALPHA_BLEND, 0.0f, 0.0f, lo));
+    EXPECT_TRUE(nb_alpha_covers(NB_ALPHA_BLEND, 1.0f, 0.0f, hi));
+    EXPECT_TRUE(nb_alpha_covers(NB_ALPHA_BLEND, 2.0f, 0.0f, hi));
+    EXPECT_FALSE(nb_alpha_covers(NB_ALPHA_BLEND, nan, 0.0f, lo)); // NaN alpha lets the ray through
+    EXPECT_FALSE(nb_alpha_covers(NB_ALPHA_MASK, nan, 0.5f, lo));
+    EXPECT_TRUE(nb_alpha_covers(NB_ALPHA_MASK, 0.5f, 0.5f, lo)); // glTF: alpha >= cutoff is opaque
+    EXPECT_FALSE(nb_alpha_covers(NB_ALPHA_MASK, 0.4999f, 0.5f, hi));
+    EXPECT_TRUE(nb_alpha_covers(NB_ALPHA_OPAQUE, nan, 0.5f, lo));
 }

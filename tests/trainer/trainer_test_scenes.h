@@ -69,6 +69,28 @@ inline Mesh cube(float scale = 1.0f, glm::vec3 offset = glm::vec3(0.0f)) {
     return m;
 }
 
+// A normal-mapped height field (16 x 16 quads, amplitude 0.2): uv set 1 = xy, tangents along +x
+// (handedness -1 on the right half), an 8x8 normal texture of varied tilts read through a
+// texture transform, normalTexture.scale 0.8. No uv set 0: the base colour is untextured.
+inline Scene normal_mapped_scene() {
+    Mesh m = height_field(16, 0.2f, 1.0f, glm::vec3(0.0f));
+    for (const glm::vec3& p : m.positions) {
+        m.uv1.push_back(glm::vec2(p.x, p.y));
+        m.tangents.push_back(glm::vec4(1.0f, 0.0f, 0.0f, p.x > 0.5f ? -1.0f : 1.0f));
+    }
+    Scene s = scene_of(m);
+    Texture t;
+    t.width = t.height = 8;
+    for (uint32_t i = 0; i < 64; ++i)
+        t.rgba8.insert(t.rgba8.end(), {uint8_t(40 + 23 * (i % 8)), uint8_t(200 - 19 * (i / 8)), uint8_t(150 + (i * 37) % 100), 255});
+    s.textures.push_back(t);
+    s.materials[0].normal_tex.texture = 0;
+    s.materials[0].normal_tex.uv_set = 1;
+    s.materials[0].normal_tex.transform = glm::mat3(2.0f, 0.0f, 0.0f, 0.0f, 1.5f, 0.0f, 0.1f, 0.2f, 1.0f);
+    s.materials[0].normal_scale = 0.8f;
+    return s;
+}
+
 // Alpha-tested surfaces (glTF alphaMode) for the ground-truth tests, one mesh, rays along -z:
 // - triangles 0-1, material 0 (MASK, cutoff 0.5): quad [0,1]^2 at z = 0, uv = xy, base-colour texture
 //   of 2x1 texels with alpha 0 (left) and 255 (right): a hole where x < 0.5;

@@ -150,6 +150,36 @@ TEST(GroundTruth, TexturedAlbedoIsSrgbDecoded) {
     EXPECT_NEAR(gt.albedo.x, 0.5f * 0.5029f, 2e-3f); // factor x texture
 }
 
+// The normal map tilts the interpolated normal in the tangent frame, from its own uv set.
+TEST(GroundTruth, NormalMapTiltsTheNormalInTangentSpace) {
+    Mesh m;
+    test::add_quad(m, {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1});
+    m.uv1 = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    m.tangents.assign(4, glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+    Scene scene = test::scene_of(m);
+    Texture t;
+    t.width = t.height = 1;
+    t.rgba8 = {218, 128, 218, 255}; // tangent space (0.710, 0.004, 0.710): 45 degrees towards +x
+    scene.textures.push_back(t);
+    scene.materials[0].normal_tex.texture = 0;
+    scene.materials[0].normal_tex.uv_set = 1;
+    const TrainingAsset asset = make_training_asset(scene, 0);
+    const GroundTruth gt = trace_ground_truth(asset, {0.3f, 0.6f, 1.0f}, {0, 0, -1}, 0.0f, 2.0f, SampleSlot{});
+    ASSERT_TRUE(gt.hit);
+    EXPECT_NEAR(gt.normal.x, 0.7071f, 5e-3f);
+    EXPECT_NEAR(gt.normal.z, 0.7071f, 5e-3f);
+    EXPECT_NEAR(glm::length(gt.normal), 1.0f, 1e-5f);
+    // Scale 0 leaves the vertex normal.
+    scene.materials[0].normal_scale = 0.0f;
+    EXPECT_NEAR(trace_ground_truth(make_training_asset(scene, 0), {0.3f, 0.6f, 1.0f}, {0, 0, -1}, 0.0f, 2.0f, SampleSlot{}).normal.z,
+                1.0f, 1e-6f);
+    // Without tangents (or without the map's uv set) the vertex normal.
+    scene.materials[0].normal_scale = 1.0f;
+    scene.materials[0].normal_tex.uv_set = 0;
+    EXPECT_NEAR(trace_ground_truth(make_training_asset(scene, 0), {0.3f, 0.6f, 1.0f}, {0, 0, -1}, 0.0f, 2.0f, SampleSlot{}).normal.z,
+                1.0f, 1e-6f);
+}
+
 TEST(TextureSampler, BilinearWrap) {
     Texture t;
     t.width = 2;

@@ -18,6 +18,28 @@
 namespace nbvh {
 namespace {
 
+// The normal map of triangle `tri` (original index) of `m`; `slot` uploads a texture once and returns
+// its device index.
+template <class Slot>
+cuda::TriNormalMap normal_map_of(const Scene& scene, const Mesh& m, const Material* material, uint32_t tri,
+                                 Slot&& slot) {
+    cuda::TriNormalMap nm{-1, 1.0f, {}, {}};
+    if (!material || material->normal_tex.texture < 0 || size_t(material->normal_tex.texture) >= scene.textures.size())
+        return nm; // the CPU's fallback texel (0.5, 0.5, 1) leaves the normal as it is
+    const std::vector<glm::vec2>& uvs = material->normal_tex.uv_set == 1u ? m.uv1 : m.uv0;
+    if (uvs.size() != m.positions.size()) return nm;
+    nm.texture = slot(uint32_t(material->normal_tex.texture));
+    nm.scale = material->normal_scale;
+    const uint32_t* idx = &m.indices[size_t(tri) * 3];
+    for (int c = 0; c < 3; ++c) {
+        const glm::vec3 uv = material->normal_tex.transform * glm::vec3(uvs[idx[c]], 1.0f);
+        nm.uv[2 * c] = uv.x;
+        nm.uv[2 * c + 1] = uv.y;
+        for (int q = 0; q < 4; ++q) nm.tangent[4 * c + q] = m.tangents[idx[c]][q];
+    }
+    return nm;
+}
+
 cuda::CoreAsset flatten_asset(const TrainingAsset& asset) {
     cuda::CoreAsset a;
     const Bvh& base = asset.bvh();
@@ -60,6 +82,13 @@ cuda::CoreAsset flatten_asset(const TrainingAsset& asset) {
         return slot_of[t];
     };
     for (int i = 0; i < 256; ++i) a.srgb_table[size_t(i)] = srgb_to_linear(float(i) / 255.0f);
+    // Normal maps (ground_truth.cpp shading_normal): where a material has one and the mesh has tangents.
+    bool normal_maps = false;
+    if (m.tangents.size() == m.positions.size())
+        for (uint32_t t = 0; t < m.triangle_count() && !normal_maps; ++t) {
+            const uint32_t mat = t < m.triangle_material.size() ? m.triangle_material[t] : 0u;
+            normal_maps = mat < scene.materials.size() && scene.materials[mat].normal_tex.texture >= 0;
+        }
     const bool has_normals = m.normals.size() == m.positions.size();
     for (uint32_t k = 0; k < tris; ++k) {
         const uint32_t tri = mb.bvh.prim_indices[k];
@@ -75,6 +104,7 @@ cuda::CoreAsset flatten_asset(const TrainingAsset& asset) {
             size_t(material->base_color_tex.texture) < scene.textures.size())
             dev_tex = texture_slot(uint32_t(material->base_color_tex.texture));
         a.tri_texture[k] = dev_tex;
+        if (normal_maps) a.tri_normal_map.push_back(normal_map_of(scene, m, material, tri, texture_slot));
         if (asset.alpha_tested) {
             const bool tested = material && material->alpha_mode != AlphaMode::opaque;
             a.tri_coverage.push_back(cuda::TriCoverage{tested ? uint32_t(material->alpha_mode) : 0u, tri,

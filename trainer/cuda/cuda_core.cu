@@ -168,6 +168,10 @@ public:
             coverage_.upload(a.tri_coverage);
             da_.coverage = coverage_.p;
         }
+        if (!a.tri_normal_map.empty()) {
+            normal_maps_.upload(a.tri_normal_map);
+            da_.normal_maps = normal_maps_.p;
+        }
         da_.mesh_nodes = a.mesh_nodes.empty() ? nullptr : mesh_nodes_.p;
         da_.tri_v = tri_v_.p; da_.tri_n = tri_n_.p; da_.tri_a = tri_a_.p; da_.tri_g = tri_g_.p;
         da_.tri_uv = tri_uv_.p; da_.tri_tex = tri_tex_.p; da_.texels = texels_.p; da_.tex_info = tex_info_.p;
@@ -462,6 +466,7 @@ private:
     DevBuf<uint32_t> texels_, tex_info_;
     DevBuf<int32_t> tri_tex_;
     DevBuf<TriCoverage> coverage_;
+    DevBuf<TriNormalMap> normal_maps_;
     DevBuf<GpuBvhNode> mesh_nodes_;
     DevBuf<float> grid_w_, grid_m_, grid_v_, grid_grad_, mlp_w_, mlp_m_, mlp_v_, mlp_grad_, slices_;
     DevBuf<uint32_t> grid_t_, mlp_t_, leaf_samples_, flag_;

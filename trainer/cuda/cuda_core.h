@@ -23,6 +23,15 @@ struct TriCoverage {
     float cutoff;      // MASK threshold
 };
 
+// Normal map of one triangle of an asset with normal-mapped materials (trainer/ground_truth.cpp
+// shading_normal, shared/sampling.h nb_normal_map).
+struct TriNormalMap {
+    int32_t texture;     // index into texture_info (linear data), -1: no normal map
+    float scale;         // normalTexture.scale
+    float uv[6];         // per vertex, in the normal texture's uv set, its transform applied
+    float tangent[12];   // per vertex: xyz, w handedness
+};
+
 // Everything about the asset the GPU needs, in flat host arrays (uploaded once, except the base BVH).
 struct CoreAsset {
     // Base BVH of the N-BVH cut (CPU node order): regularised boxes (lo xyz, hi xyz) and children
@@ -42,6 +51,7 @@ struct CoreAsset {
     std::array<float, 256> srgb_table{}; // engine/core/image.h srgb_to_linear(i / 255), as the CPU sampler
     std::vector<float> tri_geo_normal;  // 3 per triangle: unit geometric normal (fallback)
     std::vector<TriCoverage> tri_coverage; // per triangle (leaf order); empty: every triangle opaque
+    std::vector<TriNormalMap> tri_normal_map; // per triangle (leaf order); empty: no normal maps
     GpuEncodingBox encoding;
     // Parts of a multi-asset run (trainer/training_asset.h TrainingPart): sampling box (lo xyz, extent
     // xyz) and base-BVH root per part; at least one.

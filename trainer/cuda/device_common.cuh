@@ -40,6 +40,7 @@ struct DevAsset {
     const float* srgb = nullptr;         // 256 entries
     const float* tri_g = nullptr;        // 3 per triangle
     const TriCoverage* coverage = nullptr; // per triangle; null: every triangle opaque
+    const TriNormalMap* normal_maps = nullptr; // per triangle; null: no normal maps
     GpuEncodingBox enc;
     const float* part_boxes = nullptr;    // 6 per part: sampling box lo xyz, extent xyz
     uint32_t parts = 1;

@@ -313,6 +313,26 @@ __device__ vec3 sample_base_colour(const DevAsset& a, int32_t tex, float u, floa
     return top * (1.0f - f.ay) + bottom * f.ay;
 }
 
+// trainer/ground_truth.cpp shading_normal's normal map: the texture read linear (bilinear, as the CPU
+// sampler with srgb = false), the shared tangent-space rule.
+__device__ vec3 normal_mapped(const DevAsset& a, uint32_t p, float u, float v, vec3 n) {
+    const TriNormalMap& nm = a.normal_maps[p];
+    if (nm.texture < 0) return n;
+    const float w = 1.0f - u - v;
+    const Footprint f = footprint(a, nm.texture, nm.uv[0] * w + nm.uv[2] * u + nm.uv[4] * v,
+                                  nm.uv[1] * w + nm.uv[3] * u + nm.uv[5] * v);
+    auto texel = [&](uint32_t i) {
+        const uint32_t c = a.texels[i];
+        return vec3(float(c & 0xFFu) / 255.0f, float((c >> 8) & 0xFFu) / 255.0f, float((c >> 16) & 0xFFu) / 255.0f);
+    };
+    const vec3 top = texel(f.i00) * (1.0f - f.ax) + texel(f.i10) * f.ax;
+    const vec3 bottom = texel(f.i01) * (1.0f - f.ax) + texel(f.i11) * f.ax;
+    const float* t = nm.tangent;
+    const vec4 t4(t[0] * w + t[4] * u + t[8] * v, t[1] * w + t[5] * u + t[9] * v, t[2] * w + t[6] * u + t[10] * v,
+                  t[3] * w + t[7] * u + t[11] * v);
+    return nb_normal_map(n, t4, top * (1.0f - f.ay) + bottom * f.ay, nm.scale);
+}
+
 __global__ void k_ground_truth(DevAsset a, DevBatch b, uint64_t seed, uint32_t step) {
     const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= b.n) return;
@@ -328,7 +348,12 @@ __global__ void k_ground_truth(DevAsset a, DevBatch b, uint64_t seed, uint32_t s
             const float* tn = a.tri_n + size_t(tri) * 9;
             vec3 n = load3(tn) * w + load3(tn + 3) * u + load3(tn + 6) * v;
             const float nl = length(n);
-            n = (nl > 1e-12f && isfinite(nl)) ? n / nl : load3(a.tri_g + size_t(tri) * 3);
+            if (nl > 1e-12f && isfinite(nl)) {
+                n = n / nl;
+                if (a.normal_maps) n = normal_mapped(a, tri, u, v, n);
+            } else {
+                n = load3(a.tri_g + size_t(tri) * 3);
+            }
             const float* ta = a.tri_a + size_t(tri) * 9;
             vec3 al = load3(ta) * w + load3(ta + 3) * u + load3(ta + 6) * v;
             const int32_t tex = a.tri_tex[tri];
