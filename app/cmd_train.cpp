@@ -43,6 +43,16 @@ struct TrainArgs {
     bool deterministic = false; // CUDA backend: order-independent gradient sums (trainer/cuda/README.md)
 };
 
+// Whether a part has alpha-blended triangles: its ground truth is a coverage draw (trainer/ground_truth.h),
+// so the check's visibility agreement tops out near max(alpha, 1 - alpha) and its depth and normal
+// errors include the surfaces behind.
+bool blended(const TrainingAsset& asset, const TrainingPart& part) {
+    const std::vector<Material>& materials = asset.scene->materials;
+    for (uint32_t mat : asset.scene->meshes[part.mesh_index].triangle_material)
+        if (mat < materials.size() && materials[mat].alpha_mode == AlphaMode::blend) return true;
+    return false;
+}
+
 void run_train(const TrainArgs& a) {
     const BackendChoice backend = resolve_backend(parse_backend(a.backend));
     TrainOptions opt = default_train_options(backend);
@@ -91,8 +101,9 @@ void run_train(const TrainArgs& a) {
         const TrainingCut cut = cut_of_tree(asset, result.tree, lod);
         for (int32_t p = 0; p < int32_t(asset.parts.size()); ++p) {
             const EvalStats e = evaluate_network(asset, cut, result.weights, 2000, opt.seed, p);
-            log_info("  LoD %u  %-32s %5.1f %%  %.3f  %4.1f deg", lod, asset.parts[size_t(p)].name.c_str(),
-                     100.0 * e.visibility_agreement, e.depth_mae, e.normal_mean_deg);
+            const TrainingPart& part = asset.parts[size_t(p)];
+            log_info("  LoD %u  %-32s %5.1f %%  %.3f  %4.1f deg%s", lod, part.name.c_str(), 100.0 * e.visibility_agreement,
+                     e.depth_mae, e.normal_mean_deg, blended(asset, part) ? "  (alpha-blended: against coverage draws)" : "");
         }
     }
     const NeuralModel model = make_neural_model(asset, result, opt, a.scene, ts.source_hash);
