@@ -188,6 +188,22 @@ std::vector<CudaDebugSample> step_and_check(const TrainingAsset& asset, StepPara
     return samples;
 }
 
+// The GPU's samples whose CPU ground truth (same keys) differs between `asset` and `variant` by `differs`:
+// how many samples a feature decides, i.e. how many a GPU that ignored it would get wrong.
+template <class Differs>
+uint32_t count_differing(const TrainingAsset& asset, const TrainingAsset& variant,
+                         const std::vector<CudaDebugSample>& samples, const StepParams& p, Differs differs) {
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < uint32_t(samples.size()); ++i) {
+        const CudaDebugSample& s = samples[i];
+        if (s.leaf < 0) continue;
+        const SampleSlot key{p.seed, p.step, i};
+        n += differs(trace_ground_truth(asset, s.origin, s.dir, 0.0f, s.length, key),
+                     trace_ground_truth(variant, s.origin, s.dir, 0.0f, s.length, key));
+    }
+    return n;
+}
+
 // Alpha-tested surfaces (trainer/ground_truth.h alpha_covers): the GPU's ground truth cuts MASK holes
 // and draws BLEND coverage exactly as the CPU's, sample by sample (same key, same draw).
 TEST(CudaBackend, AlphaCoverageGroundTruthMatchesTheCpu) {
@@ -201,15 +217,9 @@ TEST(CudaBackend, AlphaCoverageGroundTruthMatchesTheCpu) {
     Scene opaque_scene = scene;
     for (Material& m : opaque_scene.materials) m.alpha_mode = AlphaMode::opaque;
     const TrainingAsset opaque = make_training_asset(opaque_scene, 0);
-    uint32_t decided = 0;
-    for (uint32_t i = 0; i < uint32_t(samples.size()); ++i) {
-        const CudaDebugSample& s = samples[i];
-        if (s.leaf < 0) continue;
-        const SampleSlot key{p.seed, p.step, i};
-        const GroundTruth a = trace_ground_truth(asset, s.origin, s.dir, 0.0f, s.length, key);
-        const GroundTruth o = trace_ground_truth(opaque, s.origin, s.dir, 0.0f, s.length, key);
-        decided += a.hit != o.hit || a.t_hit != o.t_hit;
-    }
+    const uint32_t decided = count_differing(asset, opaque, samples, p, [](const GroundTruth& a, const GroundTruth& o) {
+        return a.hit != o.hit || a.t_hit != o.t_hit;
+    });
     std::printf("samples where alpha decides: %u of %u\n", decided, p.batch_size);
     EXPECT_GT(decided, p.batch_size / 50);
 }
@@ -226,15 +236,9 @@ TEST(CudaBackend, NormalMapGroundTruthMatchesTheCpu) {
     Scene plain_scene = scene;
     plain_scene.materials[0].normal_tex.texture = -1;
     const TrainingAsset plain = make_training_asset(plain_scene, 0);
-    uint32_t moved = 0;
-    for (uint32_t i = 0; i < uint32_t(samples.size()); ++i) {
-        const CudaDebugSample& s = samples[i];
-        if (s.leaf < 0) continue;
-        const SampleSlot key{p.seed, p.step, i};
-        const GroundTruth a = trace_ground_truth(asset, s.origin, s.dir, 0.0f, s.length, key);
-        const GroundTruth o = trace_ground_truth(plain, s.origin, s.dir, 0.0f, s.length, key);
-        moved += a.hit && glm::dot(a.normal, o.normal) < 0.99f;
-    }
+    const uint32_t moved = count_differing(asset, plain, samples, p, [](const GroundTruth& a, const GroundTruth& o) {
+        return a.hit && glm::dot(a.normal, o.normal) < 0.99f;
+    });
     std::printf("samples whose normal the map moves: %u of %u\n", moved, p.batch_size);
     EXPECT_GT(moved, p.batch_size / 50);
 }

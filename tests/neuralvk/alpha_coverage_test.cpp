@@ -19,11 +19,11 @@
 
 #include <cmath>
 
-#include "engine/bvh/scene_accel.h"
 #include "engine/core/image.h"
 #include "engine/neural/asset_table.h"
 #include "engine/render/wavefront.h"
 #include "engine/scene/environment.h"
+#include "tests/render/test_scenes.h"
 #include "tests/trainer/trainer_test_scenes.h"
 #include "trainer/model_export.h"
 #include "trainer/trainer.h"
@@ -113,11 +113,6 @@ NeuralModel train(const Scene& scene) {
 }
 
 Image render_frame(const Scene& scene, const NeuralModel* model, int& validation) {
-    vk::ContextOptions co;
-    co.device = vk::DeviceChoice::cpu;
-    co.validation = true;
-    vk::Context ctx(co);
-    const SceneAccel accel = build_scene_accel(scene);
     RenderOptions o;
     o.width = o.height = SIZE;
     o.spp = 16;
@@ -126,10 +121,9 @@ Image render_frame(const Scene& scene, const NeuralModel* model, int& validation
     o.neural.path = NeuralPath::scalar;
     if (model) o.neural.model = model;
     else o.neural.classical = true;
-    WavefrontRenderer r(ctx, scene, accel, default_sky(), scene.camera, o);
-    Image img = convert_channels(r.render().image, 3);
-    validation = ctx.validation_message_count();
-    return img;
+    const test::LavapipeRender r = test::render_lavapipe(scene, default_sky(), scene.camera, o);
+    validation = r.validation;
+    return convert_channels(r.result.image, 3);
 }
 
 // Pixels whose centre ray crosses z = 0 at least MARGIN inside the pane starting at x0.
