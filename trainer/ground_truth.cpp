@@ -60,9 +60,15 @@ glm::vec3 shading_normal(const TrainingAsset& asset, const Material* material, u
 
 } // namespace
 
-bool alpha_covers(const TrainingAsset& asset, uint32_t tri, float u, float v, const SampleSlot& key) {
+bool alpha_covers(const TrainingAsset& asset, uint32_t tri, float u, float v, const glm::vec3& dir,
+                  const SampleSlot& key) {
     const Material* material = material_of(asset, tri);
     if (!material || material->alpha_mode == AlphaMode::opaque) return true;
+    if (material->alpha_mode == AlphaMode::blend && !material->double_sided) {
+        const Mesh& m = *asset.mesh;
+        const uint32_t* idx = &m.indices[size_t(tri) * 3];
+        if (nb_back_facing(m.positions[idx[0]], m.positions[idx[1]], m.positions[idx[2]], dir)) return false;
+    }
     float alpha = material->base_color.w;
     glm::vec2 uv;
     if (material->base_color_tex.texture >= 0 && base_color_uv(*asset.mesh, material, tri, u, v, uv))
@@ -73,7 +79,7 @@ bool alpha_covers(const TrainingAsset& asset, uint32_t tri, float u, float v, co
 bool closest_triangle_hit(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir, float tmin,
                           float tmax, const SampleSlot& key, float& t, uint32_t& triangle, float& u, float& v) {
     Hit hit;
-    const HitFilter accept = [&](uint32_t tri, float hu, float hv) { return alpha_covers(asset, tri, hu, hv, key); };
+    const HitFilter accept = [&](uint32_t tri, float hu, float hv) { return alpha_covers(asset, tri, hu, hv, dir, key); };
     if (!intersect_closest(asset.mesh_bvh, Ray{origin, dir}, tmin, tmax, hit, asset.alpha_tested ? &accept : nullptr))
         return false;
     t = hit.t;

@@ -23,12 +23,17 @@ struct GroundTruth {
 bool closest_triangle_hit(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir, float tmin,
                           float tmax, const SampleSlot& key, float& t, uint32_t& triangle, float& u, float& v);
 
-// Whether a hit at barycentrics (u, v) of triangle `tri` (original index) counts: its material's glTF
-// alphaMode with alpha = base-colour factor x texture alpha (shared/scene_gpu.h nb_alpha_covers, the
-// classical traversal's rule); blended surfaces stop a ray with probability alpha, drawn from `key`.
-// Departure from the paper and the official code, whose ground truth has no alpha: without it a
-// cut-out (MASK) or translucent (BLEND) surface is learned opaque.
-bool alpha_covers(const TrainingAsset& asset, uint32_t tri, float u, float v, const SampleSlot& key);
+// Whether a hit at barycentrics (u, v) of triangle `tri` (original index), on a ray along `dir`, counts:
+// its material's glTF alphaMode with alpha = base-colour factor x texture alpha (shared/scene_gpu.h
+// nb_alpha_covers, the classical traversal's rule); blended surfaces stop a ray with probability alpha,
+// drawn from `key`, and the back faces of single-sided blended ones never do (as in the classical
+// traversal: the learned probability is then the front face's, not the compound of a thin shell's two
+// faces; for opaque materials the ground truth keeps back faces, as the paper's: culling them made thin
+// leaves' visibility depend on a direction their encoded points barely show). Departure from the paper
+// and the official code, whose ground truth has no alpha: without it a cut-out (MASK) or translucent
+// (BLEND) surface is learned opaque.
+bool alpha_covers(const TrainingAsset& asset, uint32_t tri, float u, float v, const glm::vec3& dir,
+                  const SampleSlot& key);
 
 // `key`: the sample's random streams (its slot of the step); only blended surfaces use it.
 GroundTruth trace_ground_truth(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir,

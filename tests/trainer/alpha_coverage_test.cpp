@@ -1,6 +1,7 @@
 // Alpha-tested surfaces in the trainer's ground truth (trainer/ground_truth.h alpha_covers): a MASK
 // cut-out lets rays through where its texture's alpha is below the cutoff, a BLEND surface stops a
-// fraction alpha of the rays, independently per sample and triangle, reproducibly for a sample's key.
+// fraction alpha of the rays, independently per sample and triangle, reproducibly for a sample's key,
+// and none through its back face when single-sided.
 #include <gtest/gtest.h>
 
 #include "tests/trainer/trainer_test_scenes.h"
@@ -76,4 +77,17 @@ TEST(AlphaCoverage, BlendStopsAFractionAlphaOfTheRays) {
         last = now;
     }
     EXPECT_GT(changes, 40u); // 2 * 0.3 * 0.7 * 199 = 84 expected
+    // Single-sided (the scene's default): rays from behind pass the blended quad's back face, as in the
+    // classical traversal; double-sided: a fraction alpha of them stops there too.
+    Scene two_sided = scene;
+    two_sided.materials[1].double_sided = true;
+    const TrainingAsset b = make_training_asset(two_sided, 0);
+    uint32_t from_behind = 0, from_behind_two_sided = 0;
+    for (uint32_t slot = 0; slot < 2000; ++slot) {
+        const SampleSlot key{13, 0, slot};
+        from_behind += trace_ground_truth(a, {1.7f, 0.3f, -0.25f}, {0, 0, 1}, 0.0f, 1.25f, key).hit;
+        from_behind_two_sided += trace_ground_truth(b, {1.7f, 0.3f, -0.25f}, {0, 0, 1}, 0.0f, 1.25f, key).hit;
+    }
+    EXPECT_EQ(from_behind, 0u);
+    EXPECT_NEAR(double(from_behind_two_sided) / 2000.0, 0.3, 0.04);
 }

@@ -109,7 +109,8 @@ cuda::CoreAsset flatten_asset(const TrainingAsset& asset) {
             const bool tested = material && material->alpha_mode != AlphaMode::opaque;
             a.tri_coverage.push_back(cuda::TriCoverage{tested ? uint32_t(material->alpha_mode) : 0u, tri,
                                                  tested ? material->base_color.w : 1.0f,
-                                                 tested ? material->alpha_cutoff : 0.0f});
+                                                 tested ? material->alpha_cutoff : 0.0f,
+                                                 tested && !material->double_sided ? 1u : 0u});
         }
         for (int c = 0; c < 3; ++c) {
             const glm::vec3 p = mb.vertices[size_t(k) * 3 + c];

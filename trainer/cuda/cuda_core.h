@@ -21,6 +21,7 @@ struct TriCoverage {
     uint32_t triangle; // original index: the key of its coverage draw, as on the CPU
     float factor;      // base-colour alpha factor (times the texture's alpha where tri_texture has one)
     float cutoff;      // MASK threshold
+    uint32_t single_sided; // 1: a BLEND triangle's back face lets every ray through
 };
 
 // Normal map of one triangle of an asset with normal-mapped materials (trainer/ground_truth.cpp

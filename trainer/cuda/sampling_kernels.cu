@@ -229,9 +229,10 @@ __device__ void triangle_uv(const DevAsset& a, uint32_t p, float u, float v, flo
 
 // trainer/ground_truth.cpp alpha_covers for triangle p (leaf order): factor x the texture's alpha
 // (bilinear, as the CPU sampler), the shared rule and the same draw.
-__device__ bool covers(const DevAsset& a, uint32_t p, float u, float v, const SampleSlot& key) {
+__device__ bool covers(const DevAsset& a, uint32_t p, float u, float v, bool back_facing, const SampleSlot& key) {
     const TriCoverage c = a.coverage[p];
     if (c.mode == NB_ALPHA_OPAQUE) return true;
+    if (c.mode == NB_ALPHA_BLEND && c.single_sided != 0u && back_facing) return false;
     float alpha = c.factor;
     const int32_t tex = a.tri_tex[p];
     if (tex >= 0) {
@@ -274,9 +275,10 @@ __device__ bool closest_hit(const DevAsset& a, vec3 o, vec3 d, float tmin, float
                 const uint32_t first = nb_leaf_first(ref), count = nb_leaf_count(ref);
                 for (uint32_t p = first; p < first + count; ++p) {
                     const float* tv = a.tri_v + size_t(p) * 9;
+                    const vec3 v0 = load3(tv), v1 = load3(tv + 3), v2 = load3(tv + 6);
                     float tt, uu, vv;
-                    if (nb_intersect_triangle(o, d, load3(tv), load3(tv + 3), load3(tv + 6), tmin, best, tt, uu, vv) &&
-                        (!a.coverage || covers(a, p, uu, vv, key))) {
+                    if (nb_intersect_triangle(o, d, v0, v1, v2, tmin, best, tt, uu, vv) &&
+                        (!a.coverage || covers(a, p, uu, vv, nb_back_facing(v0, v1, v2, d), key))) {
                         best = tt; t = tt; u = uu; v = vv; tri = p; hit = true;
                     }
                 }
