@@ -43,9 +43,9 @@ struct TrainArgs {
     bool deterministic = false; // CUDA backend: order-independent gradient sums (trainer/cuda/README.md)
 };
 
-// Whether a part has alpha-blended triangles: its ground truth is a coverage draw (trainer/ground_truth.h),
-// so the check's visibility agreement tops out near max(alpha, 1 - alpha) and its depth and normal
-// errors include the surfaces behind.
+// Whether a part has alpha-blended triangles: its visibility target is a stop probability
+// (trainer/ground_truth.h), so the check's agreement is with its majority (above 0.5), and its depth
+// and normal errors include the surfaces the coverage draws reach behind.
 bool blended(const TrainingAsset& asset, const TrainingPart& part) {
     const std::vector<Material>& materials = asset.scene->materials;
     for (uint32_t mat : asset.scene->meshes[part.mesh_index].triangle_material)
@@ -103,7 +103,7 @@ void run_train(const TrainArgs& a) {
             const EvalStats e = evaluate_network(asset, cut, result.weights, 2000, opt.seed, p);
             const TrainingPart& part = asset.parts[size_t(p)];
             log_info("  LoD %u  %-32s %5.1f %%  %.3f  %4.1f deg%s", lod, part.name.c_str(), 100.0 * e.visibility_agreement,
-                     e.depth_mae, e.normal_mean_deg, blended(asset, part) ? "  (alpha-blended: against coverage draws)" : "");
+                     e.depth_mae, e.normal_mean_deg, blended(asset, part) ? "  (alpha-blended: agreement with the stop probability above 0.5)" : "");
         }
     }
     const NeuralModel model = make_neural_model(asset, result, opt, a.scene, ts.source_hash);

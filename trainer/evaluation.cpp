@@ -39,7 +39,7 @@ EvalStats evaluate_network(const TrainingAsset& asset, const TrainingCut& cut, c
         const neural::Outputs y = neural::forward(weights, q, neural::Precision::fp32);
         e.rays++;
         const bool hit = nb_decode_visibility(y[NB_OUT_VISIBILITY], NB_VISIBILITY_THRESHOLD);
-        if (hit == gt.hit) agree++;
+        if (hit == (gt.visibility > 0.5f)) agree++; // blended surfaces: the stop probability's majority
         if (hit && gt.hit) {
             e.both_hit++;
             float t_pred;

@@ -14,7 +14,7 @@ namespace nbvh {
 
 struct EvalStats {
     uint32_t rays = 0;                 // rays that met a leaf of the cut (evaluated)
-    double visibility_agreement = 0.0; // fraction with (y0 > 0.5) == ground-truth hit
+    double visibility_agreement = 0.0; // fraction with (y0 > 0.5) == (ground-truth visibility > 0.5)
     uint32_t both_hit = 0;             // rays where both say hit (depth/normal measured on these)
     double depth_mae = 0.0;            // mean |t_pred - t_gt| / segment length (local depth units)
     double depth_p90 = 0.0;            // 90th percentile of the same

@@ -60,26 +60,67 @@ glm::vec3 shading_normal(const TrainingAsset& asset, const Material* material, u
 
 } // namespace
 
+namespace {
+
+// Alpha of a hit: base-colour factor x texture alpha.
+float surface_alpha(const TrainingAsset& asset, const Material& material, uint32_t tri, float u, float v) {
+    float alpha = material.base_color.w;
+    glm::vec2 uv;
+    if (material.base_color_tex.texture >= 0 && base_color_uv(*asset.mesh, &material, tri, u, v, uv))
+        alpha *= sample_texture_ref(asset.scene->textures, material.base_color_tex, uv, true, glm::vec4(1.0f)).w;
+    return alpha;
+}
+
+// A back face of a single-sided blended triangle: rays pass it (the classical traversal's rule).
+bool blended_back_face(const TrainingAsset& asset, const Material& material, uint32_t tri, const glm::vec3& dir) {
+    if (material.alpha_mode != AlphaMode::blend || material.double_sided) return false;
+    const Mesh& m = *asset.mesh;
+    const uint32_t* idx = &m.indices[size_t(tri) * 3];
+    return nb_back_facing(m.positions[idx[0]], m.positions[idx[1]], m.positions[idx[2]], dir);
+}
+
+} // namespace
+
 bool alpha_covers(const TrainingAsset& asset, uint32_t tri, float u, float v, const glm::vec3& dir,
                   const SampleSlot& key) {
     const Material* material = material_of(asset, tri);
     if (!material || material->alpha_mode == AlphaMode::opaque) return true;
-    if (material->alpha_mode == AlphaMode::blend && !material->double_sided) {
-        const Mesh& m = *asset.mesh;
-        const uint32_t* idx = &m.indices[size_t(tri) * 3];
-        if (nb_back_facing(m.positions[idx[0]], m.positions[idx[1]], m.positions[idx[2]], dir)) return false;
-    }
-    float alpha = material->base_color.w;
-    glm::vec2 uv;
-    if (material->base_color_tex.texture >= 0 && base_color_uv(*asset.mesh, material, tri, u, v, uv))
-        alpha *= sample_texture_ref(asset.scene->textures, material->base_color_tex, uv, true, glm::vec4(1.0f)).w;
-    return nb_alpha_covers(uint32_t(material->alpha_mode), alpha, material->alpha_cutoff, key.coverage_bits(tri));
+    if (blended_back_face(asset, *material, tri, dir)) return false;
+    return nb_alpha_covers(uint32_t(material->alpha_mode), surface_alpha(asset, *material, tri, u, v),
+                           material->alpha_cutoff, key.coverage_bits(tri));
+}
+
+StopProbability stop_probability(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir,
+                                 float tmin, float tmax) {
+    StopProbability s;
+    float pass = 1.0f;
+    bool solid = false;
+    const HitFilter visit = [&](uint32_t tri, float t, float u, float v) {
+        const Material* material = material_of(asset, tri);
+        if (!material || material->alpha_mode == AlphaMode::opaque) {
+            solid = true;
+            return true; // nothing behind it matters
+        }
+        if (blended_back_face(asset, *material, tri, dir)) return false;
+        const float alpha = surface_alpha(asset, *material, tri, u, v);
+        if (material->alpha_mode == AlphaMode::mask) {
+            solid = solid || alpha >= material->alpha_cutoff;
+            return alpha >= material->alpha_cutoff;
+        }
+        pass *= 1.0f - (std::isfinite(alpha) ? std::clamp(alpha, 0.0f, 1.0f) : 0.0f);
+        if (t < s.nearest_t) s = StopProbability{0.0f, t, tri, u, v};
+        return false; // every blended crossing counts
+    };
+    Hit hit;
+    intersect_closest(asset.mesh_bvh, Ray{origin, dir}, tmin, tmax, hit, &visit);
+    s.probability = solid ? 1.0f : 1.0f - pass;
+    return s;
 }
 
 bool closest_triangle_hit(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir, float tmin,
                           float tmax, const SampleSlot& key, float& t, uint32_t& triangle, float& u, float& v) {
     Hit hit;
-    const HitFilter accept = [&](uint32_t tri, float hu, float hv) { return alpha_covers(asset, tri, hu, hv, dir, key); };
+    const HitFilter accept = [&](uint32_t tri, float, float hu, float hv) { return alpha_covers(asset, tri, hu, hv, dir, key); };
     if (!intersect_closest(asset.mesh_bvh, Ray{origin, dir}, tmin, tmax, hit, asset.alpha_tested ? &accept : nullptr))
         return false;
     t = hit.t;
@@ -92,9 +133,28 @@ bool closest_triangle_hit(const TrainingAsset& asset, const glm::vec3& origin, c
 GroundTruth trace_ground_truth(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir,
                                float t_entry, float t_exit, const SampleSlot& key) {
     GroundTruth gt;
-    float t, u, v;
-    uint32_t tri;
-    if (!closest_triangle_hit(asset, origin, dir, t_entry, t_exit, key, t, tri, u, v)) return gt;
+    float t = 0.0f, u = 0.0f, v = 0.0f;
+    uint32_t tri = 0;
+    const bool drawn = closest_triangle_hit(asset, origin, dir, t_entry, t_exit, key, t, tri, u, v);
+    if (asset.alpha_tested) {
+        // Visibility target: the probability that the segment stops the ray, not the draw's 0 or 1; the
+        // surface: the draw's, else (the draws let the ray through) the nearest blended crossing.
+        const StopProbability s = stop_probability(asset, origin, dir, t_entry, t_exit);
+        gt.visibility = s.probability;
+        if (!drawn && s.probability > 0.0f) {
+            t = s.nearest_t;
+            tri = s.triangle;
+            u = s.u;
+            v = s.v;
+        } else if (!drawn) {
+            return gt;
+        }
+    } else if (!drawn) {
+        return gt;
+    } else {
+        gt.visibility = 1.0f;
+    }
+    if (!(gt.visibility > 0.0f)) return GroundTruth{};
     gt.hit = true;
     gt.t_hit = t;
     gt.triangle = tri;

@@ -70,7 +70,7 @@ bool intersect(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit&
                 if (!mesh.single_sided.empty() && mesh.single_sided[k] &&
                     nb_back_facing(v[3 * k], v[3 * k + 1], v[3 * k + 2], ray.dir))
                     continue;
-                if (accept && !(*accept)(bvh.prim_indices[k], u, w)) continue;
+                if (accept && !(*accept)(bvh.prim_indices[k], t, u, w)) continue;
                 found = true;
                 t_max = t;
                 hit = Hit{t, bvh.prim_indices[k], u, w};

@@ -38,8 +38,9 @@ BvhBuildOptions default_blas_options();
 
 MeshBvh build_mesh_bvh(const Mesh& mesh, const BvhBuildOptions& options = default_blas_options());
 
-// Which candidate hits count (alpha-tested surfaces): original triangle index and barycentrics.
-using HitFilter = std::function<bool(uint32_t triangle, float u, float v)>;
+// Which candidate hits count (alpha-tested surfaces): original triangle index, ray parameter and
+// barycentrics. A filter that accepts nothing visits every crossing of [tmin, tmax].
+using HitFilter = std::function<bool(uint32_t triangle, float t, float u, float v)>;
 
 // Closest hit with t in [tmin, tmax]; `hit` is written only when it returns true. With `accept`, only
 // the hits it accepts.

@@ -26,10 +26,10 @@ float composite_loss(const Outputs& y, const Targets& t, const LossConfig& cfg, 
     return total;
 }
 
-Targets make_targets(bool hit, float depth_u, vec3 n, vec3 albedo) {
+Targets make_targets(bool hit, float depth_u, vec3 n, vec3 albedo, float visibility) {
     Targets t{};
     if (!hit) return t;
-    t[NB_OUT_VISIBILITY] = 1.0f;
+    t[NB_OUT_VISIBILITY] = visibility;
     t[NB_OUT_DEPTH] = std::clamp(depth_u, 0.0f, 1.0f);
     t[NB_OUT_NORMAL + 0] = (n.x + 1.0f) * 0.5f;
     t[NB_OUT_NORMAL + 1] = (n.y + 1.0f) * 0.5f;

@@ -22,8 +22,9 @@ struct LossConfig {
 // The shared header's form of the config.
 GpuLossConfig to_gpu(const LossConfig& cfg);
 
-// Targets in output slots: visibility (0/1), depth u in [0,1] (nb_encode_depth_target), normal
-// (n+1)/2, albedo. A miss has visibility 0 (the other slots are ignored when masking).
+// Targets in output slots: visibility (0 miss, 1 hit; an alpha-blended surface's stop probability,
+// trainer/ground_truth.h), depth u in [0,1] (nb_encode_depth_target), normal (n+1)/2, albedo. A miss
+// has visibility 0 (the other slots are ignored when masking).
 using Targets = std::array<float, NB_MLP_OUTPUTS>;
 
 // Per-sample weighted loss; writes dL/dy (post-sigmoid) when dl_dy != nullptr and the weighted per-slot
@@ -36,6 +37,6 @@ float composite_loss(const Outputs& y, const Targets& t, const LossConfig& cfg, 
 inline float presigmoid_gradient(float dl_dy, float y) { return nb_presigmoid_gradient(dl_dy, y); }
 
 // Target of one ground-truth hit (see neural_query.h nb_encode_depth_target for u).
-Targets make_targets(bool hit, float depth_u, vec3 unit_normal, vec3 albedo);
+Targets make_targets(bool hit, float depth_u, vec3 unit_normal, vec3 albedo, float visibility = 1.0f);
 
 } // namespace nbvh::neural

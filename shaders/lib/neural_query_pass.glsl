@@ -41,15 +41,15 @@ NbPendingQuery nb_load_pending(uint k) {
 }
 
 // Whether a visible-or-not answer stops the ray. Alpha-blended assets (glTF BLEND): the network learned
-// the probability that the leaf segment stops a ray (both trainers' ground truth covers stochastically,
-// shared/scene_gpu.h nb_alpha_covers), so the hit is taken with that probability, as the classical
-// traversal takes a blended triangle; above the threshold, a lens of alpha 0.3 would vanish and one of
-// 0.7 turn opaque. Every other asset keeps the threshold (`thresholded`). A departure from the paper
-// and the official code, which have no alpha. One draw per ray (and depth) and instance, not per leaf:
-// N-BVH leaf boxes overlap, and every leaf whose box holds a crossing learned its probability, so
-// independent draws per leaf would compound (Flight Helmet's lenses alone, camera rays: transmission
-// 0.44 with a draw per leaf, 0.70 with one per instance, classical 0.79; the rest is the lenses' back
-// faces, which the classical traversal lets through (single-sided) and the ground truth does not).
+// the probability that the leaf segment stops a ray (both trainers' visibility target,
+// trainer/ground_truth.h), so the hit is taken with that probability (shared/scene_gpu.h
+// nb_alpha_covers), as the classical traversal takes a blended triangle; above the threshold, a lens of
+// alpha 0.3 would vanish and one of 0.7 turn opaque. Every other asset keeps the threshold
+// (`thresholded`). A departure from the paper and the official code, which have no alpha. One draw per
+// ray (and depth) and instance, not per leaf: N-BVH leaf boxes overlap, and every leaf whose box holds
+// a crossing learned its probability, so independent draws per leaf compound (Flight Helmet's lenses
+// alone, camera rays, lavapipe: transmission 0.44 with a draw per leaf, 0.70 with one per instance,
+// 0.79 once the ground truth also let rays through the lenses' single-sided back faces; classical 0.79).
 bool nb_neural_covers(NbPendingQuery r, bool shadow, float visibility, bool thresholded) {
     if (!NB_HAS_ALPHA_MASK) return thresholded;
     uint material = neural_assets[instances[r.pl.instance].blas_root].material;

@@ -75,7 +75,7 @@ uint32_t check_rays_and_truth(const TrainingAsset& asset, const StepParams& p, c
     for (uint32_t i = 0; i < uint32_t(samples.size()); ++i) {
         const CudaDebugSample& s = samples[i];
         const GroundTruth gt = trace_ground_truth(asset, s.origin, s.dir, 0.0f, s.length, SampleSlot{p.seed, p.step, i});
-        if (gt.hit != (s.target[0] > 0.5f)) { hit_mismatch++; continue; }
+        if (std::fabs(gt.visibility - s.target[0]) > 1e-3f) { hit_mismatch++; continue; }
         if (!gt.hit) continue;
         if (std::fabs(gt.depth - s.target[1]) > 1e-4f) depth_off++;
         const glm::vec3 n((s.target[2] * 2 - 1), (s.target[3] * 2 - 1), (s.target[4] * 2 - 1));
@@ -218,7 +218,7 @@ TEST(CudaBackend, AlphaCoverageGroundTruthMatchesTheCpu) {
     for (Material& m : opaque_scene.materials) m.alpha_mode = AlphaMode::opaque;
     const TrainingAsset opaque = make_training_asset(opaque_scene, 0);
     const uint32_t decided = count_differing(asset, opaque, samples, p, [](const GroundTruth& a, const GroundTruth& o) {
-        return a.hit != o.hit || a.t_hit != o.t_hit;
+        return a.hit != o.hit || a.t_hit != o.t_hit || a.visibility != o.visibility;
     });
     std::printf("samples where alpha decides: %u of %u\n", decided, p.batch_size);
     EXPECT_GT(decided, p.batch_size / 50);

@@ -89,5 +89,30 @@ TEST(AlphaCoverage, BlendStopsAFractionAlphaOfTheRays) {
         from_behind_two_sided += trace_ground_truth(b, {1.7f, 0.3f, -0.25f}, {0, 0, 1}, 0.0f, 1.25f, key).hit;
     }
     EXPECT_EQ(from_behind, 0u);
-    EXPECT_NEAR(double(from_behind_two_sided) / 2000.0, 0.3, 0.04);
+    EXPECT_EQ(from_behind_two_sided, 2000u);
+    EXPECT_NEAR(trace_ground_truth(b, {1.7f, 0.3f, -0.25f}, {0, 0, 1}, 0.0f, 1.25f, SampleSlot{}).visibility, 0.3f, 1e-6f);
+}
+
+// The visibility target is the probability that the segment stops the ray, not the draw: alpha for the
+// blended quad alone, 1 with the opaque backdrop behind it in the segment, 1 - 0.7^2 for two blended
+// layers; the surface is the draw's, or the nearest blended crossing when the draws let the ray through.
+TEST(AlphaCoverage, VisibilityTargetIsTheStopProbability) {
+    Scene scene = test::alpha_quads_scene();
+    const TrainingAsset a = make_training_asset(scene, 0);
+    for (uint32_t slot = 0; slot < 64; ++slot) {
+        const SampleSlot key{17, 2, slot};
+        const GroundTruth front = trace_ground_truth(a, {1.7f, 0.3f, 1.0f}, {0, 0, -1}, 0.0f, 1.25f, key);
+        ASSERT_TRUE(front.hit);
+        EXPECT_NEAR(front.visibility, 0.3f, 1e-6f);
+        EXPECT_NEAR(front.t_hit, 1.0f, 1e-6f); // drawn or not, the quad is the only surface
+        EXPECT_EQ(trace_ground_truth(a, {1.7f, 0.3f, 1.0f}, {0, 0, -1}, 0.0f, 2.0f, key).visibility, 1.0f);
+        // Opaque and MASK-kept surfaces: 1; a MASK hole: what lies behind.
+        EXPECT_EQ(trace_ground_truth(a, {0.75f, 0.5f, 1.0f}, {0, 0, -1}, 0.0f, 1.25f, key).visibility, 1.0f);
+        EXPECT_FALSE(trace_ground_truth(a, {0.25f, 0.5f, 1.0f}, {0, 0, -1}, 0.0f, 1.25f, key).hit);
+    }
+    // Two blended layers: the backdrop made blended too (alpha 0.3, no texture).
+    scene.materials[2] = scene.materials[1];
+    const TrainingAsset two = make_training_asset(scene, 0);
+    EXPECT_NEAR(trace_ground_truth(two, {1.7f, 0.3f, 1.0f}, {0, 0, -1}, 0.0f, 2.0f, SampleSlot{}).visibility,
+                1.0f - 0.7f * 0.7f, 1e-6f);
 }

@@ -8,6 +8,7 @@
 
 #include "shaders/shared/neural_query.h"
 #include "shaders/shared/scene_gpu.h"
+#include "engine/neural/shared/training_loss.h"
 #include "tests/trainer/trainer_test_scenes.h"
 #include "trainer/cpu/cpu_backend.h"
 #include "trainer/ground_truth.h"
@@ -168,4 +169,21 @@ TEST(Numerics, NormalMapAndAlphaCoverageAtTheirEdges) {
     EXPECT_TRUE(nb_alpha_covers(NB_ALPHA_MASK, 0.5f, 0.5f, lo)); // glTF: alpha >= cutoff is opaque
     EXPECT_FALSE(nb_alpha_covers(NB_ALPHA_MASK, 0.4999f, 0.5f, hi));
     EXPECT_TRUE(nb_alpha_covers(NB_ALPHA_OPAQUE, nan, 0.5f, lo));
+}
+
+// The visibility loss of a soft target is the KL divergence: 0 where the prediction equals the target,
+// positive elsewhere, with the BCE's gradient; binary targets keep the plain BCE.
+TEST(Numerics, SoftVisibilityTargetsHaveNoLossFloor) {
+    float d = 1.0f;
+    EXPECT_NEAR(nb_loss_bce(0.3f, 0.3f, d), 0.0f, 1e-6f);
+    EXPECT_NEAR(d, 0.0f, 1e-5f);
+    EXPECT_GT(nb_loss_bce(0.6f, 0.3f, d), 0.1f);
+    EXPECT_GT(d, 0.0f);
+    EXPECT_NEAR(nb_loss_bce(0.25f, 1.0f, d), -std::log(0.25f), 1e-6f);
+    EXPECT_NEAR(nb_loss_bce(0.25f, 0.0f, d), -std::log(0.75f), 1e-6f);
+    for (float t : {1e-7f, 0.5f, 1.0f - 1e-7f})
+        for (float y : {0.0f, 1e-6f, 0.5f, 1.0f}) {
+            const float v = nb_loss_bce(y, t, d);
+            EXPECT_TRUE(std::isfinite(v) && v >= 0.0f && std::isfinite(d)) << y << " " << t;
+        }
 }

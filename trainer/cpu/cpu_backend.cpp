@@ -123,7 +123,7 @@ public:
                                                               SampleSlot{params.seed, params.step, i});
                     nb_segment_points(asset_.encoding, s.origin, s.dir, 0.0f, s.length, queries[n].points[0],
                                       queries[n].points[1], queries[n].points[2]);
-                    meta[n] = {neural::make_targets(gt.hit, gt.depth, gt.normal, gt.albedo), gt.hit, s.cut, s.leaf};
+                    meta[n] = {neural::make_targets(gt.hit, gt.depth, gt.normal, gt.albedo, gt.visibility), gt.hit, s.cut, s.leaf};
                     n++;
                 }
                 if (n == 0) break;

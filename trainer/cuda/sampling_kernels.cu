@@ -227,13 +227,10 @@ __device__ void triangle_uv(const DevAsset& a, uint32_t p, float u, float v, flo
     vv = tu[1] * w + tu[3] * u + tu[5] * v;
 }
 
-// trainer/ground_truth.cpp alpha_covers for triangle p (leaf order): factor x the texture's alpha
-// (bilinear, as the CPU sampler), the shared rule and the same draw.
-__device__ bool covers(const DevAsset& a, uint32_t p, float u, float v, bool back_facing, const SampleSlot& key) {
-    const TriCoverage c = a.coverage[p];
-    if (c.mode == NB_ALPHA_OPAQUE) return true;
-    if (c.mode == NB_ALPHA_BLEND && c.single_sided != 0u && back_facing) return false;
-    float alpha = c.factor;
+// Base-colour alpha of triangle p (leaf order) at (u, v): factor x the texture's alpha (bilinear, as the
+// CPU sampler).
+__device__ float surface_alpha(const DevAsset& a, uint32_t p, float u, float v) {
+    float alpha = a.coverage[p].factor;
     const int32_t tex = a.tri_tex[p];
     if (tex >= 0) {
         float uu, vv;
@@ -244,18 +241,26 @@ __device__ bool covers(const DevAsset& a, uint32_t p, float u, float v, bool bac
         const float bottom = al(f.i01) * (1.0f - f.ax) + al(f.i11) * f.ax;
         alpha *= top * (1.0f - f.ay) + bottom * f.ay;
     }
-    return nb_alpha_covers(c.mode, alpha, c.cutoff, key.coverage_bits(c.triangle));
+    return alpha;
 }
 
-// Closest hit in [tmin, tmax] over the GpuBvhNode tree (nearest child first) that alpha keeps.
-__device__ bool closest_hit(const DevAsset& a, vec3 o, vec3 d, float tmin, float tmax, const SampleSlot& key,
-                            float& t, uint32_t& tri, float& u, float& v) {
+// trainer/ground_truth.cpp alpha_covers for triangle p (leaf order): the shared rule and the same draw.
+__device__ bool covers(const DevAsset& a, uint32_t p, float u, float v, bool back_facing, const SampleSlot& key) {
+    const TriCoverage c = a.coverage[p];
+    if (c.mode == NB_ALPHA_OPAQUE) return true;
+    if (c.mode == NB_ALPHA_BLEND && c.single_sided != 0u && back_facing) return false;
+    return nb_alpha_covers(c.mode, surface_alpha(a, p, u, v), c.cutoff, key.coverage_bits(c.triangle));
+}
+
+// Walks the GpuBvhNode tree over [tmin, best] (nearest child first) and calls
+// crossing(p, tt, uu, vv, back_facing) for every triangle the ray crosses there (p in leaf order); a
+// crossing that returns true sets best = tt (later ones must be nearer).
+template <class Crossing>
+__device__ void walk(const DevAsset& a, vec3 o, vec3 d, float tmin, float& best, Crossing crossing) {
     const vec3 inv = nb_safe_inv_dir(d);
     uint32_t stack[NB_BVH_MAX_DEPTH + 2];
     int top = 0;
     uint32_t node = 0;
-    bool hit = false;
-    float best = tmax;
     for (;;) {
         const GpuBvhNode n = a.mesh_nodes[node];
         float tl, tr;
@@ -278,9 +283,8 @@ __device__ bool closest_hit(const DevAsset& a, vec3 o, vec3 d, float tmin, float
                     const vec3 v0 = load3(tv), v1 = load3(tv + 3), v2 = load3(tv + 6);
                     float tt, uu, vv;
                     if (nb_intersect_triangle(o, d, v0, v1, v2, tmin, best, tt, uu, vv) &&
-                        (!a.coverage || covers(a, p, uu, vv, nb_back_facing(v0, v1, v2, d), key))) {
-                        best = tt; t = tt; u = uu; v = vv; tri = p; hit = true;
-                    }
+                        crossing(p, tt, uu, vv, nb_back_facing(v0, v1, v2, d)))
+                        best = tt;
                 }
             } else {
                 inner[ni] = ref;
@@ -298,7 +302,45 @@ __device__ bool closest_hit(const DevAsset& a, vec3 o, vec3 d, float tmin, float
         if (top == 0) break;
         node = stack[--top];
     }
+}
+
+// Closest hit in [tmin, tmax] that alpha keeps (trainer/ground_truth.cpp closest_triangle_hit).
+__device__ bool closest_hit(const DevAsset& a, vec3 o, vec3 d, float tmin, float tmax, const SampleSlot& key,
+                            float& t, uint32_t& tri, float& u, float& v) {
+    bool hit = false;
+    float best = tmax;
+    walk(a, o, d, tmin, best, [&](uint32_t p, float tt, float uu, float vv, bool back_facing) {
+        if (a.coverage && !covers(a, p, uu, vv, back_facing, key)) return false;
+        t = tt; u = uu; v = vv; tri = p; hit = true;
+        return true;
+    });
     return hit;
+}
+
+// trainer/ground_truth.cpp stop_probability: 1 at an opaque or kept MASK crossing, else 1 - prod(1 -
+// alpha) over the blended crossings; the nearest blended crossing (nt infinite: none).
+__device__ float stop_probability(const DevAsset& a, vec3 o, vec3 d, float tmin, float tmax, float& nt,
+                                  uint32_t& ntri, float& nu, float& nv) {
+    float pass = 1.0f, best = tmax;
+    bool solid = false;
+    nt = NB_INF;
+    walk(a, o, d, tmin, best, [&](uint32_t p, float tt, float uu, float vv, bool back_facing) {
+        const TriCoverage c = a.coverage[p];
+        if (c.mode == NB_ALPHA_OPAQUE) {
+            solid = true;
+            return true;
+        }
+        if (c.mode == NB_ALPHA_BLEND && c.single_sided != 0u && back_facing) return false;
+        const float alpha = surface_alpha(a, p, uu, vv);
+        if (c.mode == NB_ALPHA_MASK) {
+            solid = solid || alpha >= c.cutoff;
+            return alpha >= c.cutoff;
+        }
+        pass *= 1.0f - (isfinite(alpha) ? fminf(fmaxf(alpha, 0.0f), 1.0f) : 0.0f);
+        if (tt < nt) { nt = tt; ntri = p; nu = uu; nv = vv; }
+        return false;
+    });
+    return solid ? 1.0f : 1.0f - pass;
 }
 
 // engine/scene/texture_sampler.cpp sample_texture_bilinear with srgb = true, RGB only (same float
@@ -345,7 +387,15 @@ __global__ void k_ground_truth(DevAsset a, DevBatch b, uint64_t seed, uint32_t s
     if (b.leaf[i] >= 0) {
         float t = 0.0f, u = 0.0f, v = 0.0f;
         uint32_t tri = 0;
-        if (a.mesh_nodes && closest_hit(a, o, d, 0.0f, len, SampleSlot{seed, step, i}, t, tri, u, v)) {
+        const bool drawn = a.mesh_nodes && closest_hit(a, o, d, 0.0f, len, SampleSlot{seed, step, i}, t, tri, u, v);
+        float visibility = drawn ? 1.0f : 0.0f;
+        if (a.mesh_nodes && a.coverage) { // soft target: the stop probability (ground_truth.h)
+            float nt, nu, nv;
+            uint32_t ntri = 0;
+            visibility = stop_probability(a, o, d, 0.0f, len, nt, ntri, nu, nv);
+            if (!drawn && visibility > 0.0f) { t = nt; tri = ntri; u = nu; v = nv; }
+        }
+        if (visibility > 0.0f) {
             const float w = 1.0f - u - v;
             const float* tn = a.tri_n + size_t(tri) * 9;
             vec3 n = load3(tn) * w + load3(tn + 3) * u + load3(tn + 6) * v;
@@ -366,7 +416,7 @@ __global__ void k_ground_truth(DevAsset a, DevBatch b, uint64_t seed, uint32_t s
                 al = vec3(al.x * c.x, al.y * c.y, al.z * c.z);
             }
             al = clamp(al, vec3(0.0f), vec3(1.0f));
-            tg[0] = 1.0f;
+            tg[0] = visibility;
             tg[1] = nb_encode_depth_target(a.enc, t, 0.0f, len, false);
             tg[2] = (n.x + 1.0f) * 0.5f; tg[3] = (n.y + 1.0f) * 0.5f; tg[4] = (n.z + 1.0f) * 0.5f;
             tg[5] = al.x; tg[6] = al.y; tg[7] = al.z;

@@ -7,7 +7,10 @@
 // (post-sigmoid), what reference_network backward() and the CUDA backward take:
 //   L = w_vis * BCE(y0, t0) + w_depth * |y1 - t1| + w_normal * sum_i |N(y_i) - t_i| (i = 2..4)
 //       + w_albedo * sum_i (y_i - t_i)^2 / (y_i^2 + 0.01) (i = 5..7)
-//   BCE: p = clamp(y0, 1e-5, 1 - 1e-5), -(t log p + (1-t) log(1-p)), dL/dy0 = -(t - p)/(p (1 - p))
+//   BCE: p = clamp(y0, 1e-5, 1 - 1e-5), -(t log p + (1-t) log(1-p)) - H(t), dL/dy0 = -(t - p)/(p (1 - p))
+//   (H(t) the target's entropy, 0 for t = 0 or 1: the value is the KL divergence, 0 at y = t, so a
+//   soft target -- the stop probability of an alpha-blended surface, trainer/ground_truth.h -- leaves
+//   no floor that the split ranking would chase; the gradient is the BCE's. Binary targets: the BCE)
 //   (the official code divides by p - p^2, which cancels near p = 1: 1e-5 relative at the clamp and
 //   3e-5 between host and device, measured on the H100; 1 - p is exact for p >= 1/2, so p (1 - p) is
 //   within a few ulps everywhere -- same function, rounding only)
@@ -18,7 +21,7 @@
 //        (n + 1)/2 of the unit shading normal. With normal_linear = 0, N(y) = y.
 //   Relative L2 (albedo): the denominator y^2 + 0.01 is treated as a CONSTANT in the gradient,
 //        dL/dy = 2 (y - t)/(y^2 + 0.01), exactly like tcnn's RelativeL2 (not the true derivative).
-//   Masking: when t0 < 0.5 (no hit), depth/normal/albedo terms have value and gradient 0.
+//   Masking: when t0 = 0 (no hit), depth/normal/albedo terms have value and gradient 0.
 // Normalisation over the batch is the caller's (tcnn divides value and gradient by batch * 8 and scales
 // gradients by the fp16 loss scale that Adam divides back out); so is the non-finite check of y.
 #ifndef NB_TRAINING_LOSS_H
@@ -36,16 +39,22 @@
 struct GpuLossConfig {
     float w_visibility, w_depth, w_normal, w_albedo;
     uint normal_linear;      // 1: N(y) = 10 y - 4.5
-    uint visibility_masking; // 1: no depth/normal/albedo terms where the target has no hit
+    uint visibility_masking; // 1: no depth/normal/albedo terms where the target has no hit (t0 = 0)
 };
 
 NB_FN float nb_loss_sign(float x) { return x > 0.0f ? 1.0f : (x < 0.0f ? -1.0f : 0.0f); }
+
+// Entropy of a visibility target in nats (0 for t = 0 or 1).
+NB_FN float nb_target_entropy(float t) {
+    return (t > 0.0f && t < 1.0f) ? -(t * logf(t) + (1.0f - t) * logf(1.0f - t)) : 0.0f;
+}
 
 // Each term unweighted: returns its value, writes dvalue/dy.
 NB_FN float nb_loss_bce(float y, float t, NB_OUT(float) d) {
     const float p = fminf(fmaxf(y, NB_BCE_CLAMP), 1.0f - NB_BCE_CLAMP);
     d = -(t - p) / (p * (1.0f - p));
-    return -(t * logf(p) + (1.0f - t) * logf(1.0f - p));
+    const float bce = -(t * logf(p) + (1.0f - t) * logf(1.0f - p));
+    return (t > 0.0f && t < 1.0f) ? fmaxf(bce - nb_target_entropy(t), 0.0f) : bce;
 }
 NB_FN float nb_loss_l1(float y, float t, NB_OUT(float) d) {
     const float e = y - t;
@@ -85,7 +94,7 @@ NB_FN float nb_composite_loss(const float* y, const float* t, NB_IN(GpuLossConfi
     float d = 0.0f;
     value[NB_OUT_VISIBILITY] = nb_loss_bce(y[NB_OUT_VISIBILITY], t[NB_OUT_VISIBILITY], d);
     dl_dy[NB_OUT_VISIBILITY] = c.w_visibility * d;
-    if (!(c.visibility_masking != 0u && t[NB_OUT_VISIBILITY] < 0.5f)) {
+    if (!(c.visibility_masking != 0u && t[NB_OUT_VISIBILITY] <= 0.0f)) {
         value[NB_OUT_DEPTH] = nb_loss_l1(y[NB_OUT_DEPTH], t[NB_OUT_DEPTH], d);
         dl_dy[NB_OUT_DEPTH] = c.w_depth * d;
         for (uint i = NB_OUT_NORMAL; i < NB_OUT_NORMAL + 3u; ++i) {
