@@ -118,11 +118,22 @@ StopProbability stop_probability(const TrainingAsset& asset, const glm::vec3& or
 }
 
 bool closest_triangle_hit(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir, float tmin,
-                          float tmax, const SampleSlot& key, float& t, uint32_t& triangle, float& u, float& v) {
+                          float tmax, const SampleSlot& key, float& t, uint32_t& triangle, float& u, float& v,
+                          bool* blended) {
     Hit hit;
-    const HitFilter accept = [&](uint32_t tri, float, float hu, float hv) { return alpha_covers(asset, tri, hu, hv, dir, key); };
-    if (!intersect_closest(asset.mesh_bvh, Ray{origin, dir}, tmin, tmax, hit, asset.alpha_tested ? &accept : nullptr))
-        return false;
+    bool hit_blended = false, met_blended = false;
+    const HitFilter accept = [&](uint32_t tri, float, float hu, float hv) {
+        const Material* material = material_of(asset, tri);
+        const bool blend = material && material->alpha_mode == AlphaMode::blend;
+        met_blended = met_blended || blend;
+        if (!alpha_covers(asset, tri, hu, hv, dir, key)) return false;
+        hit_blended = blend;
+        return true;
+    };
+    const bool found =
+        intersect_closest(asset.mesh_bvh, Ray{origin, dir}, tmin, tmax, hit, asset.alpha_tested ? &accept : nullptr);
+    if (blended) *blended = found ? hit_blended : met_blended;
+    if (!found) return false;
     t = hit.t;
     triangle = hit.triangle;
     u = hit.u;
@@ -135,10 +146,12 @@ GroundTruth trace_ground_truth(const TrainingAsset& asset, const glm::vec3& orig
     GroundTruth gt;
     float t = 0.0f, u = 0.0f, v = 0.0f;
     uint32_t tri = 0;
-    const bool drawn = closest_triangle_hit(asset, origin, dir, t_entry, t_exit, key, t, tri, u, v);
-    if (asset.alpha_tested) {
+    bool blended = false;
+    const bool drawn = closest_triangle_hit(asset, origin, dir, t_entry, t_exit, key, t, tri, u, v, &blended);
+    if (asset.alpha_tested && blended) {
         // Visibility target: the probability that the segment stops the ray, not the draw's 0 or 1; the
-        // surface: the draw's, else (the draws let the ray through) the nearest blended crossing.
+        // surface: the draw's, else (the draws let the ray through) the nearest blended crossing. (Only
+        // where a blended surface was met: else it is 1 with a hit, 0 without.)
         const StopProbability s = stop_probability(asset, origin, dir, t_entry, t_exit);
         gt.visibility = s.probability;
         if (!drawn && s.probability > 0.0f) {

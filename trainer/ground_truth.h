@@ -21,8 +21,10 @@ struct GroundTruth {
 
 // Closest hit of the asset's triangles with t in [tmin, tmax] that its material's alpha keeps
 // (alpha_covers). Returns false on a miss. `key` draws the stochastic coverage of blended surfaces.
+// `blended` (optional): the hit, or with no hit some crossing met on the way, is alpha-blended.
 bool closest_triangle_hit(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir, float tmin,
-                          float tmax, const SampleSlot& key, float& t, uint32_t& triangle, float& u, float& v);
+                          float tmax, const SampleSlot& key, float& t, uint32_t& triangle, float& u, float& v,
+                          bool* blended = nullptr);
 
 // Whether a hit at barycentrics (u, v) of triangle `tri` (original index), on a ray along `dir`, counts:
 // its material's glTF alphaMode with alpha = base-colour factor x texture alpha (shared/scene_gpu.h

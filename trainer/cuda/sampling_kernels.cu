@@ -305,15 +305,21 @@ __device__ void walk(const DevAsset& a, vec3 o, vec3 d, float tmin, float& best,
 }
 
 // Closest hit in [tmin, tmax] that alpha keeps (trainer/ground_truth.cpp closest_triangle_hit).
+// `blended`: the hit, or with no hit some crossing the walk met, is an alpha-blended one (only then
+// does the stop probability need its own walk: else it is 1 with a hit, 0 without).
 __device__ bool closest_hit(const DevAsset& a, vec3 o, vec3 d, float tmin, float tmax, const SampleSlot& key,
-                            float& t, uint32_t& tri, float& u, float& v) {
-    bool hit = false;
+                            float& t, uint32_t& tri, float& u, float& v, bool& blended) {
+    bool hit = false, hit_blended = false, met_blended = false;
     float best = tmax;
     walk(a, o, d, tmin, best, [&](uint32_t p, float tt, float uu, float vv, bool back_facing) {
+        const bool blend = a.coverage && a.coverage[p].mode == NB_ALPHA_BLEND;
+        met_blended = met_blended || blend;
         if (a.coverage && !covers(a, p, uu, vv, back_facing, key)) return false;
         t = tt; u = uu; v = vv; tri = p; hit = true;
+        hit_blended = blend;
         return true;
     });
+    blended = hit ? hit_blended : met_blended;
     return hit;
 }
 
@@ -387,9 +393,11 @@ __global__ void k_ground_truth(DevAsset a, DevBatch b, uint64_t seed, uint32_t s
     if (b.leaf[i] >= 0) {
         float t = 0.0f, u = 0.0f, v = 0.0f;
         uint32_t tri = 0;
-        const bool drawn = a.mesh_nodes && closest_hit(a, o, d, 0.0f, len, SampleSlot{seed, step, i}, t, tri, u, v);
+        bool blended = false;
+        const bool drawn =
+            a.mesh_nodes && closest_hit(a, o, d, 0.0f, len, SampleSlot{seed, step, i}, t, tri, u, v, blended);
         float visibility = drawn ? 1.0f : 0.0f;
-        if (a.mesh_nodes && a.coverage) { // soft target: the stop probability (ground_truth.h)
+        if (a.mesh_nodes && a.coverage && blended) { // soft target: the stop probability (ground_truth.h)
             float nt, nu, nv;
             uint32_t ntri = 0;
             visibility = stop_probability(a, o, d, 0.0f, len, nt, ntri, nu, nv);
