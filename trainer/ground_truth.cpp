@@ -58,10 +58,6 @@ glm::vec3 shading_normal(const TrainingAsset& asset, const Material* material, u
     return n;
 }
 
-} // namespace
-
-namespace {
-
 // Alpha of a hit: base-colour factor x texture alpha.
 float surface_alpha(const TrainingAsset& asset, const Material& material, uint32_t tri, float u, float v) {
     float alpha = material.base_color.w;
@@ -148,24 +144,19 @@ GroundTruth trace_ground_truth(const TrainingAsset& asset, const glm::vec3& orig
     uint32_t tri = 0;
     bool blended = false;
     const bool drawn = closest_triangle_hit(asset, origin, dir, t_entry, t_exit, key, t, tri, u, v, &blended);
+    gt.visibility = drawn ? 1.0f : 0.0f;
     if (asset.alpha_tested && blended) {
         // Visibility target: the probability that the segment stops the ray, not the draw's 0 or 1; the
         // surface: the draw's, else (the draws let the ray through) the nearest blended crossing. (Only
         // where a blended surface was met: else it is 1 with a hit, 0 without.)
         const StopProbability s = stop_probability(asset, origin, dir, t_entry, t_exit);
         gt.visibility = s.probability;
-        if (!drawn && s.probability > 0.0f) {
+        if (!drawn) {
             t = s.nearest_t;
             tri = s.triangle;
             u = s.u;
             v = s.v;
-        } else if (!drawn) {
-            return gt;
         }
-    } else if (!drawn) {
-        return gt;
-    } else {
-        gt.visibility = 1.0f;
     }
     if (!(gt.visibility > 0.0f)) return GroundTruth{};
     gt.hit = true;

@@ -219,6 +219,14 @@ __device__ Footprint footprint(const DevAsset& a, int32_t tex, float u, float v)
     return Footprint{r0 + uint32_t(x0), r0 + uint32_t(x1), r1 + uint32_t(x0), r1 + uint32_t(x1), x - fx, y - fy};
 }
 
+// The bilinear mix of texel(i) (float or vec3) over footprint f, in glm::mix's operation order.
+template <class Texel>
+__device__ auto bilerp(const Footprint& f, Texel texel) {
+    const auto top = texel(f.i00) * (1.0f - f.ax) + texel(f.i10) * f.ax;
+    const auto bottom = texel(f.i01) * (1.0f - f.ax) + texel(f.i11) * f.ax;
+    return top * (1.0f - f.ay) + bottom * f.ay;
+}
+
 // Interpolated base-colour uv of triangle p (leaf order) at barycentrics (u, v).
 __device__ void triangle_uv(const DevAsset& a, uint32_t p, float u, float v, float& uu, float& vv) {
     const float* tu = a.tri_uv + size_t(p) * 6;
@@ -235,11 +243,7 @@ __device__ float surface_alpha(const DevAsset& a, uint32_t p, float u, float v) 
     if (tex >= 0) {
         float uu, vv;
         triangle_uv(a, p, u, v, uu, vv);
-        const Footprint f = footprint(a, tex, uu, vv);
-        auto al = [&](uint32_t i) { return float(a.texels[i] >> 24) / 255.0f; };
-        const float top = al(f.i00) * (1.0f - f.ax) + al(f.i10) * f.ax;
-        const float bottom = al(f.i01) * (1.0f - f.ax) + al(f.i11) * f.ax;
-        alpha *= top * (1.0f - f.ay) + bottom * f.ay;
+        alpha *= bilerp(footprint(a, tex, uu, vv), [&](uint32_t i) { return float(a.texels[i] >> 24) / 255.0f; });
     }
     return alpha;
 }
@@ -352,15 +356,10 @@ __device__ float stop_probability(const DevAsset& a, vec3 o, vec3 d, float tmin,
 // engine/scene/texture_sampler.cpp sample_texture_bilinear with srgb = true, RGB only (same float
 // operations: sRGB decoded per texel through the same table, then filtered; REPEAT wrap).
 __device__ vec3 sample_base_colour(const DevAsset& a, int32_t tex, float u, float v) {
-    const Footprint f = footprint(a, tex, u, v);
-    auto texel = [&](uint32_t i) {
+    return bilerp(footprint(a, tex, u, v), [&](uint32_t i) {
         const uint32_t c = a.texels[i];
         return vec3(a.srgb[c & 0xFFu], a.srgb[(c >> 8) & 0xFFu], a.srgb[(c >> 16) & 0xFFu]);
-    };
-    // glm::mix(p, q, t) = p * (1 - t) + q * t
-    const vec3 top = texel(f.i00) * (1.0f - f.ax) + texel(f.i10) * f.ax;
-    const vec3 bottom = texel(f.i01) * (1.0f - f.ax) + texel(f.i11) * f.ax;
-    return top * (1.0f - f.ay) + bottom * f.ay;
+    });
 }
 
 // trainer/ground_truth.cpp shading_normal's normal map: the texture read linear (bilinear, as the CPU
@@ -371,16 +370,14 @@ __device__ vec3 normal_mapped(const DevAsset& a, uint32_t p, float u, float v, v
     const float w = 1.0f - u - v;
     const Footprint f = footprint(a, nm.texture, nm.uv[0] * w + nm.uv[2] * u + nm.uv[4] * v,
                                   nm.uv[1] * w + nm.uv[3] * u + nm.uv[5] * v);
-    auto texel = [&](uint32_t i) {
+    const vec3 texel = bilerp(f, [&](uint32_t i) {
         const uint32_t c = a.texels[i];
         return vec3(float(c & 0xFFu) / 255.0f, float((c >> 8) & 0xFFu) / 255.0f, float((c >> 16) & 0xFFu) / 255.0f);
-    };
-    const vec3 top = texel(f.i00) * (1.0f - f.ax) + texel(f.i10) * f.ax;
-    const vec3 bottom = texel(f.i01) * (1.0f - f.ax) + texel(f.i11) * f.ax;
+    });
     const float* t = nm.tangent;
     const vec4 t4(t[0] * w + t[4] * u + t[8] * v, t[1] * w + t[5] * u + t[9] * v, t[2] * w + t[6] * u + t[10] * v,
                   t[3] * w + t[7] * u + t[11] * v);
-    return nb_normal_map(n, t4, top * (1.0f - f.ay) + bottom * f.ay, nm.scale);
+    return nb_normal_map(n, t4, texel, nm.scale);
 }
 
 __global__ void k_ground_truth(DevAsset a, DevBatch b, uint64_t seed, uint32_t step) {
