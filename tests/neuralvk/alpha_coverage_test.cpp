@@ -12,7 +12,7 @@
 // pane's mean colour within 12 % of the classical per channel (the backdrop seen through it makes its
 // green and blue); the fence's pixels classified hole / fence (green above red) agree with the
 // classical on 80 % (holes half of it; a solid fence: ~50 %). Measured (400 steps, ~5 s on 2 cores):
-// pane 0.014, fence 0.996; with the query's threshold instead of the coverage draw the pane vanishes
+// pane 0.011, fence 0.996; with the query's threshold instead of the coverage draw the pane vanishes
 // (0.71). Control: the classical render of the scene with both materials opaque fails both bounds
 // (0.78, 0.56).
 #include <gtest/gtest.h>
