@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <ctime>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "app/commands.h"
 #include "engine/core/error.h"
@@ -34,16 +36,34 @@ std::string utc_date(int64_t unix_seconds) {
 
 uint64_t classical_bytes(const TrainingMetadata& m) { return mesh_and_blas_bytes(m.source_triangles, m.source_vertices); }
 
+// N-BVH nodes and leaves of the subtree under `root` (the finest cut; load_model checked the indices:
+// children follow their parent).
+std::pair<uint32_t, uint32_t> subtree_size(const NeuralModel& m, uint32_t root) {
+    uint32_t nodes = 0, leaves = 0;
+    std::vector<uint32_t> stack{root};
+    while (!stack.empty() && nodes < m.nodes.size()) {
+        const uint32_t i = stack.back();
+        stack.pop_back();
+        nodes++;
+        if (!m.nodes[i].has_children()) leaves++;
+        else stack.insert(stack.end(), {m.nodes[i].left, m.nodes[i].left + 1});
+    }
+    return {nodes, leaves};
+}
+
 void print_model(const std::string& path) {
     const NeuralModel m = load_model(path);
     const NbvhTree tree = m.tree();
     const NeuralConfig& c = m.cfg;
     std::printf("model        %s (format version %u)\n", path.c_str(), m.file_version);
     std::printf("assets       %zu (each its own N-BVH subtree, one shared network)\n", m.assets.size());
-    for (const ModelAsset& as : m.assets)
-        std::printf("  %-28s %8u triangles  %zu node%s  root %u  scale %g%s\n", as.name.c_str(), as.triangles,
-                    as.node_paths.size(), as.node_paths.size() == 1 ? "" : "s", as.root, double(as.scale),
+    for (const ModelAsset& as : m.assets) {
+        const auto [nodes, leaves] = subtree_size(m, as.root);
+        std::printf("  %-28s %8u triangles  %5u N-BVH nodes (%u leaves)  %zu scene node%s  root %u  scale %g%s\n",
+                    as.name.c_str(), as.triangles, nodes, leaves, as.node_paths.size(),
+                    as.node_paths.size() == 1 ? "" : "s", as.root, double(as.scale),
                     as.geometry_hash ? "" : "  (no fingerprint: format version 1)");
+    }
     std::printf("encoding box (%g, %g, %g) - (%g, %g, %g)\n", m.encoding_box.lo.x, m.encoding_box.lo.y,
                 m.encoding_box.lo.z, m.encoding_box.hi.x, m.encoding_box.hi.y, m.encoding_box.hi.z);
     std::printf("hash grid    %u levels x %u features, base resolution %u, per-level scale %g, 2^%u entries per "

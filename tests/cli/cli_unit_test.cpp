@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <regex>
+
 #include "tests/cli/run_nbvh.h"
 #include "tests/support/test_support.h"
 
@@ -279,6 +281,12 @@ TEST(CliInfo, TruncatedAndCorruptModels) {
     ASSERT_EQ(w.exit_code, 0) << w.describe();
     const nbvh::test::RunResult ok = run_nbvh({"info", (dir / "ok.nbvh").string()});
     ASSERT_EQ(ok.exit_code, 0) << ok.describe();
+    // Per asset, its N-BVH subtree: with one asset, the whole tree.
+    std::smatch asset_nodes, tree_nodes;
+    ASSERT_TRUE(std::regex_search(ok.out, asset_nodes, std::regex(R"(\s(\d+) N-BVH nodes \((\d+) leaves\))"))) << ok.out;
+    ASSERT_TRUE(std::regex_search(ok.out, tree_nodes, std::regex(R"(n-bvh\s+(\d+) nodes, (\d+) leaves)"))) << ok.out;
+    EXPECT_EQ(asset_nodes[1].str(), tree_nodes[1].str());
+    EXPECT_EQ(asset_nodes[2].str(), tree_nodes[2].str());
     const std::string bytes = read_file(dir / "ok.nbvh");
     ASSERT_GT(bytes.size(), 64u);
     for (size_t len : {size_t(4), size_t(16), bytes.size() / 3, bytes.size() / 2, bytes.size() - 1}) {
