@@ -57,7 +57,8 @@ bool nb_neural_covers(NbPendingQuery r, bool shadow, float visibility, bool thre
     uint cap = ray_capacity();
     uint seed = shadow ? nb_shadow_alpha_seed(shadow_load1(NB_SHADOW_PIXEL, r.pl.ray - cap) & ~NB_RAY_BACKFACE_BIT)
                        : ray_load1(pc.in_queue, NB_RAY_RNG, r.pl.ray) ^ (pc.depth << 24u);
-    return nb_alpha_covers(NB_ALPHA_BLEND, visibility, 0.0f, nb_pcg_hash(seed ^ nb_pcg_hash(r.pl.instance + 0x68E31DA4u)));
+    uint draw = nb_pcg_hash(seed ^ nb_pcg_hash(r.pl.instance + 0x68E31DA4u));
+    return nb_alpha_covers(NB_ALPHA_BLEND, visibility, 0.0f, draw);
 }
 
 // The accepted hit of a pair (t NB_INF: none): visible and accepted, in front of the ray's start and
@@ -74,7 +75,8 @@ float nb_neural_pair_hit(NbPendingQuery r, float y[NB_MLP_OUTPUTS], out vec3 nor
                     NB_RAY_BACKFACE_BIT) != 0u;
     normal = vec3(0.0f, 0.0f, 1.0f);
     albedo = h.albedo;
-    if ((h.flags & NB_NEURAL_ACCEPTED) != 0u && nb_neural_covers(r, shadow, h.visibility, (h.flags & NB_NEURAL_VISIBLE) != 0u) &&
+    bool visible = (h.flags & NB_NEURAL_VISIBLE) != 0u;
+    if ((h.flags & NB_NEURAL_ACCEPTED) != 0u && nb_neural_covers(r, shadow, h.visibility, visible) &&
         h.t > tmin && h.t < tmax && !nb_backface_skip(flagged, shadow, nb_query_reversed(r.pl.t_enter), h.normal, r.dir)) {
         vec3 n = nb_xform_normal(instances[r.pl.instance].world_to_object, h.normal);
         float len = length(n);
