@@ -77,14 +77,19 @@ bool blended_back_face(const TrainingAsset& asset, const Material& material, uin
 
 } // namespace
 
-bool alpha_covers(const TrainingAsset& asset, uint32_t tri, float u, float v, const glm::vec3& dir,
-                  const SampleSlot& key) {
-    const Material* material = material_of(asset, tri);
+namespace {
+
+// Whether a hit at barycentrics (u, v) of triangle `tri` (original index, its `material`), on a ray
+// along `dir`, counts (ground_truth.h).
+bool alpha_covers(const TrainingAsset& asset, const Material* material, uint32_t tri, float u, float v,
+                     const glm::vec3& dir, const SampleSlot& key) {
     if (!material || material->alpha_mode == AlphaMode::opaque) return true;
     if (blended_back_face(asset, *material, tri, dir)) return false;
     return nb_alpha_covers(uint32_t(material->alpha_mode), surface_alpha(asset, *material, tri, u, v),
                            material->alpha_cutoff, key.coverage_bits(tri));
 }
+
+} // namespace
 
 StopProbability stop_probability(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir,
                                  float tmin, float tmax) {
@@ -99,9 +104,10 @@ StopProbability stop_probability(const TrainingAsset& asset, const glm::vec3& or
         }
         if (blended_back_face(asset, *material, tri, dir)) return false;
         const float alpha = surface_alpha(asset, *material, tri, u, v);
-        if (material->alpha_mode == AlphaMode::mask) {
-            solid = solid || alpha >= material->alpha_cutoff;
-            return alpha >= material->alpha_cutoff;
+        if (material->alpha_mode == AlphaMode::mask) { // the shared rule; a MASK test draws nothing
+            const bool kept = nb_alpha_covers(NB_ALPHA_MASK, alpha, material->alpha_cutoff, 0u);
+            solid = solid || kept;
+            return kept;
         }
         pass *= 1.0f - (std::isfinite(alpha) ? std::clamp(alpha, 0.0f, 1.0f) : 0.0f);
         if (t < s.nearest_t) s = StopProbability{0.0f, t, tri, u, v};
@@ -122,7 +128,7 @@ bool closest_triangle_hit(const TrainingAsset& asset, const glm::vec3& origin, c
         const Material* material = material_of(asset, tri);
         const bool blend = material && material->alpha_mode == AlphaMode::blend;
         met_blended = met_blended || blend;
-        if (!alpha_covers(asset, tri, hu, hv, dir, key)) return false;
+        if (!alpha_covers(asset, material, tri, hu, hv, dir, key)) return false;
         hit_blended = blend;
         return true;
     };

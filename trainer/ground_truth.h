@@ -19,14 +19,7 @@ struct GroundTruth {
     uint32_t triangle = 0;
 };
 
-// Closest hit of the asset's triangles with t in [tmin, tmax] that its material's alpha keeps
-// (alpha_covers). Returns false on a miss. `key` draws the stochastic coverage of blended surfaces.
-// `blended` (optional): the hit, or with no hit some crossing met on the way, is alpha-blended.
-bool closest_triangle_hit(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir, float tmin,
-                          float tmax, const SampleSlot& key, float& t, uint32_t& triangle, float& u, float& v,
-                          bool* blended = nullptr);
-
-// Whether a hit at barycentrics (u, v) of triangle `tri` (original index), on a ray along `dir`, counts:
+// Which hits count (ground_truth.cpp alpha_covers; the closest hit and the stop probability use it):
 // its material's glTF alphaMode with alpha = base-colour factor x texture alpha (shared/scene_gpu.h
 // nb_alpha_covers, the classical traversal's rule); blended surfaces stop a ray with probability alpha,
 // drawn from `key`, and the back faces of single-sided blended ones never do (as in the classical
@@ -35,8 +28,13 @@ bool closest_triangle_hit(const TrainingAsset& asset, const glm::vec3& origin, c
 // leaves' visibility depend on a direction their encoded points barely show). Departure from the paper
 // and the official code, whose ground truth has no alpha: without it a cut-out (MASK) or translucent
 // (BLEND) surface is learned opaque.
-bool alpha_covers(const TrainingAsset& asset, uint32_t tri, float u, float v, const glm::vec3& dir,
-                  const SampleSlot& key);
+
+// Closest hit of the asset's triangles with t in [tmin, tmax] that its material's alpha keeps
+// (alpha_covers). Returns false on a miss. `key` draws the stochastic coverage of blended surfaces.
+// `blended` (optional): the hit, or with no hit some crossing met on the way, is alpha-blended.
+bool closest_triangle_hit(const TrainingAsset& asset, const glm::vec3& origin, const glm::vec3& dir, float tmin,
+                          float tmax, const SampleSlot& key, float& t, uint32_t& triangle, float& u, float& v,
+                          bool* blended = nullptr);
 
 // The probability that a ray on [tmin, tmax] is stopped (1 at an opaque or kept MASK crossing, else
 // 1 - prod(1 - alpha) over the blended crossings, whose draws are independent) and the nearest blended

@@ -204,7 +204,7 @@ uint32_t count_differing(const TrainingAsset& asset, const TrainingAsset& varian
     return n;
 }
 
-// Alpha-tested surfaces (trainer/ground_truth.h alpha_covers): the GPU's ground truth cuts MASK holes
+// Alpha-tested surfaces (trainer/ground_truth.cpp alpha_covers): the GPU's ground truth cuts MASK holes
 // and draws BLEND coverage exactly as the CPU's, sample by sample (same key, same draw).
 TEST(CudaBackend, AlphaCoverageGroundTruthMatchesTheCpu) {
     REQUIRE_GPU();

@@ -3,7 +3,7 @@
 // white backdrop; one CPU training run; the hybrid render against the true classical scene.
 //
 // The trainers' ground truth covers alpha-tested surfaces as the classical traversal does
-// (trainer/ground_truth.h alpha_covers): the network learns the fence's holes and, for the pane, the
+// (trainer/ground_truth.cpp alpha_covers): the network learns the fence's holes and, for the pane, the
 // probability that a ray is stopped, which the query takes as the chance of a hit for blended assets
 // (lib/neural_query_pass.glsl nb_neural_covers). Before: the pane was trained opaque (and, if it had
 // learned 0.4, the 0.5 threshold would have hidden it), the fence a solid wall.

@@ -1,4 +1,4 @@
-// Alpha-tested surfaces in the trainer's ground truth (trainer/ground_truth.h alpha_covers): a MASK
+// Alpha-tested surfaces in the trainer's ground truth (trainer/ground_truth.cpp alpha_covers): a MASK
 // cut-out lets rays through where its texture's alpha is below the cutoff, a BLEND surface stops a
 // fraction alpha of the rays, independently per sample and triangle, reproducibly for a sample's key,
 // and none through its back face when single-sided.

@@ -15,7 +15,7 @@
 
 namespace nbvh::cuda {
 
-// Alpha coverage of one triangle of an alpha-tested asset (trainer/ground_truth.h alpha_covers).
+// Alpha coverage of one triangle of an alpha-tested asset (trainer/ground_truth.cpp alpha_covers).
 struct TriCoverage {
     uint32_t mode;     // NB_ALPHA_* of its material
     uint32_t triangle; // original index: the key of its coverage draw, as on the CPU

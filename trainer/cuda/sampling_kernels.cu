@@ -235,10 +235,10 @@ __device__ void triangle_uv(const DevAsset& a, uint32_t p, float u, float v, flo
     vv = tu[1] * w + tu[3] * u + tu[5] * v;
 }
 
-// Base-colour alpha of triangle p (leaf order) at (u, v): factor x the texture's alpha (bilinear, as the
-// CPU sampler).
-__device__ float surface_alpha(const DevAsset& a, uint32_t p, float u, float v) {
-    float alpha = a.coverage[p].factor;
+// Base-colour alpha of triangle p (leaf order, coverage c) at (u, v): factor x the texture's alpha
+// (bilinear, as the CPU sampler).
+__device__ float surface_alpha(const DevAsset& a, const TriCoverage& c, uint32_t p, float u, float v) {
+    float alpha = c.factor;
     const int32_t tex = a.tri_tex[p];
     if (tex >= 0) {
         float uu, vv;
@@ -248,12 +248,18 @@ __device__ float surface_alpha(const DevAsset& a, uint32_t p, float u, float v) 
     return alpha;
 }
 
-// trainer/ground_truth.cpp alpha_covers for triangle p (leaf order): the shared rule and the same draw.
-__device__ bool covers(const DevAsset& a, uint32_t p, float u, float v, bool back_facing, const SampleSlot& key) {
-    const TriCoverage c = a.coverage[p];
+// trainer/ground_truth.cpp blended_back_face: a single-sided blended triangle seen from behind.
+__device__ bool blended_back_face(const TriCoverage& c, bool back_facing) {
+    return c.mode == NB_ALPHA_BLEND && c.single_sided != 0u && back_facing;
+}
+
+// trainer/ground_truth.cpp alpha_covers for triangle p (leaf order, coverage c): the shared rule and the
+// same draw.
+__device__ bool covers(const DevAsset& a, const TriCoverage& c, uint32_t p, float u, float v, bool back_facing,
+                       const SampleSlot& key) {
     if (c.mode == NB_ALPHA_OPAQUE) return true;
-    if (c.mode == NB_ALPHA_BLEND && c.single_sided != 0u && back_facing) return false;
-    return nb_alpha_covers(c.mode, surface_alpha(a, p, u, v), c.cutoff, key.coverage_bits(c.triangle));
+    if (blended_back_face(c, back_facing)) return false;
+    return nb_alpha_covers(c.mode, surface_alpha(a, c, p, u, v), c.cutoff, key.coverage_bits(c.triangle));
 }
 
 // Walks the GpuBvhNode tree over [tmin, best] (nearest child first) and calls
@@ -316,9 +322,13 @@ __device__ bool closest_hit(const DevAsset& a, vec3 o, vec3 d, float tmin, float
     bool hit = false, hit_blended = false, met_blended = false;
     float best = tmax;
     walk(a, o, d, tmin, best, [&](uint32_t p, float tt, float uu, float vv, bool back_facing) {
-        const bool blend = a.coverage && a.coverage[p].mode == NB_ALPHA_BLEND;
-        met_blended = met_blended || blend;
-        if (a.coverage && !covers(a, p, uu, vv, back_facing, key)) return false;
+        bool blend = false;
+        if (a.coverage) {
+            const TriCoverage c = a.coverage[p];
+            blend = c.mode == NB_ALPHA_BLEND;
+            met_blended = met_blended || blend;
+            if (!covers(a, c, p, uu, vv, back_facing, key)) return false;
+        }
         t = tt; u = uu; v = vv; tri = p; hit = true;
         hit_blended = blend;
         return true;
@@ -340,11 +350,12 @@ __device__ float stop_probability(const DevAsset& a, vec3 o, vec3 d, float tmin,
             solid = true;
             return true;
         }
-        if (c.mode == NB_ALPHA_BLEND && c.single_sided != 0u && back_facing) return false;
-        const float alpha = surface_alpha(a, p, uu, vv);
-        if (c.mode == NB_ALPHA_MASK) {
-            solid = solid || alpha >= c.cutoff;
-            return alpha >= c.cutoff;
+        if (blended_back_face(c, back_facing)) return false;
+        const float alpha = surface_alpha(a, c, p, uu, vv);
+        if (c.mode == NB_ALPHA_MASK) { // the shared rule; a MASK test draws nothing
+            const bool kept = nb_alpha_covers(NB_ALPHA_MASK, alpha, c.cutoff, 0u);
+            solid = solid || kept;
+            return kept;
         }
         pass *= 1.0f - (isfinite(alpha) ? fminf(fmaxf(alpha, 0.0f), 1.0f) : 0.0f);
         if (tt < nt) { nt = tt; ntri = p; nu = uu; nv = vv; }
