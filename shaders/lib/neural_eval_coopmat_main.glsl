@@ -6,11 +6,10 @@ layout(set = 0, binding = NB_NEVAL_BIND_MLP, scalar) readonly buffer MlpBuffer {
 // Benchmark breakdown (NeuralEvaluator::set_part): 0 = full query, 1 = hash-grid features only (the MLP
 // skipped, outputs read straight from the staged features), 2 = MLP only (features are a cheap function
 // of the query index instead of grid lookups). Results of parts 1 and 2 are meaningless by design.
-// 3 = features with the first NB_GATHER_LEVELS levels (dense at hash 2^18) looked up at one point for
-// every query, 4 = with the others (hashed) so, 5 = all levels so: what each level group's gathers cost.
+// 3 = features of the hashed levels only (levels from NB_GATHER_LEVELS on), 4 = of the first
+// NB_GATHER_LEVELS levels only (dense for hash 2^18): where the gather's time goes, level group by group.
 layout(constant_id = 0) const uint NB_EVAL_PART = 0u;
-#define NB_STAGE_SKIP_LEVELS(l0) \
-    ((NB_EVAL_PART == 3u && (l0) == 0u) || (NB_EVAL_PART == 4u && (l0) != 0u) || NB_EVAL_PART == 5u)
+#define NB_STAGE_SKIP_LEVELS(l0) ((NB_EVAL_PART == 3u && (l0) == 0u) || (NB_EVAL_PART == 4u && (l0) != 0u))
 #include "lib/neural_grid.glsl"
 #include "lib/neural_mlp_coopmat.glsl"
 

@@ -147,15 +147,11 @@ void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
         vec3 p_even = xbit == 0u ? p : partner;
         vec3 p_odd = xbit == 0u ? partner : p;
         for (uint l0 = 0u; l0 < NB_GRID_MAX_LEVELS; l0 += NB_GATHER_LEVELS) {
-            vec4 f[NB_GATHER_LEVELS];
-#ifdef NB_STAGE_SKIP_LEVELS
-            // Benchmark breakdown (lib/neural_eval_coopmat_main.glsl): a group of levels made free by
-            // looking every query up at one point (one cache line), the code otherwise unchanged.
-            bool same = NB_STAGE_SKIP_LEVELS(l0);
-            nb_neural_levels_paired(same ? vec3(0.5f) : p_even, same ? vec3(0.5f) : p_odd, l0, xbit, f);
-#else
-            nb_neural_levels_paired(p_even, p_odd, l0, xbit, f);
+#ifdef NB_STAGE_SKIP_LEVELS // benchmark breakdown (lib/neural_eval_coopmat_main.glsl): a group of levels left out
+            if (NB_STAGE_SKIP_LEVELS(l0)) continue;
 #endif
+            vec4 f[NB_GATHER_LEVELS];
+            nb_neural_levels_paired(p_even, p_odd, l0, xbit, f);
             [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g)
                 nb_coop_x_write4(local, nb_feature_slot(k, l0 + g, 0u), valid ? f[g] : vec4(0.0f));
         }
