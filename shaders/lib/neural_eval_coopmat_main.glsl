@@ -3,17 +3,15 @@
 #include "lib/neural_eval_common.glsl"
 #extension GL_EXT_shader_16bit_storage : require
 layout(set = 0, binding = NB_NEVAL_BIND_MLP, scalar) readonly buffer MlpBuffer { float16_t neural_mlp_h[]; };
-// Benchmark breakdown (NeuralEvaluator::set_part): 0 = full query, 1 = hash-grid features only (the MLP
-// skipped, outputs read straight from the staged features), 2 = MLP only (features are a cheap function
-// of the query index instead of grid lookups). Results of parts 1 and 2 are meaningless by design.
-// 3 = features of the hashed levels only (levels from NB_GATHER_LEVELS on), 4 = of the first
-// NB_GATHER_LEVELS levels only (dense for hash 2^18): where the gather's time goes, level group by group.
-layout(constant_id = 0) const uint NB_EVAL_PART = 0u;
-#define NB_STAGE_SKIP_LEVELS(l0) ((NB_EVAL_PART == 3u && (l0) == 0u) || (NB_EVAL_PART == 4u && (l0) != 0u))
 #include "lib/neural_grid.glsl"
 #include "lib/neural_mlp_coopmat.glsl"
 
 layout(local_size_x = NB_NEURAL_GROUP) in;
+
+// Benchmark breakdown (NeuralEvaluator::set_part): 0 = full query, 1 = hash-grid features only (the MLP
+// skipped, outputs read straight from the staged features), 2 = MLP only (features are a cheap function
+// of the query index instead of grid lookups). Results of parts 1 and 2 are meaningless by design.
+layout(constant_id = 0) const uint NB_EVAL_PART = 0u;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -39,11 +37,11 @@ void main() {
     // Each subgroup stages and runs the MLP on only its own 32 rows: with NB_COOP_FAST a subgroup
     // barrier (shared-memory semantics) lets one subgroup's MLP overlap the other's gather.
     NB_COOP_SYNC();
-    if (NB_EVAL_PART != 1u && NB_EVAL_PART < 3u) nb_mlp_forward_coopmat(); // whole workgroup, uniform control flow
+    if (NB_EVAL_PART != 1u) nb_mlp_forward_coopmat(); // whole workgroup, uniform control flow
     if (!valid) return;
     float y[NB_MLP_OUTPUTS];
     for (uint r = 0u; r < NB_MLP_OUTPUTS; ++r) {
-        float pre = (NB_EVAL_PART == 1u || NB_EVAL_PART >= 3u) ? nb_coop_x_read(local, r * 12u) : nb_sh_y[local * NB_COOP_Y_STRIDE + r];
+        float pre = NB_EVAL_PART == 1u ? nb_coop_x_read(local, r * 12u) : nb_sh_y[local * NB_COOP_Y_STRIDE + r];
         y[r] = nb_sigmoid(pre);
     }
     hits[i] = nb_neural_decode(pc.box, y, q.t_entry, q.t_exit, length(q.dir), pc.threshold);

@@ -147,9 +147,6 @@ void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
         vec3 p_even = xbit == 0u ? p : partner;
         vec3 p_odd = xbit == 0u ? partner : p;
         for (uint l0 = 0u; l0 < NB_GRID_MAX_LEVELS; l0 += NB_GATHER_LEVELS) {
-#ifdef NB_STAGE_SKIP_LEVELS // benchmark breakdown (lib/neural_eval_coopmat_main.glsl): a group of levels left out
-            if (NB_STAGE_SKIP_LEVELS(l0)) continue;
-#endif
             vec4 f[NB_GATHER_LEVELS];
             nb_neural_levels_paired(p_even, p_odd, l0, xbit, f);
             [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g)

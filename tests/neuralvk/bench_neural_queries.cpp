@@ -22,9 +22,6 @@ using namespace nbvh::render;
 
 namespace {
 
-// The fast gather's level group (lib/neural_grid.glsl NB_GATHER_LEVELS).
-constexpr uint32_t NB_GATHER_LEVELS_HOST = 4;
-
 std::vector<GpuNeuralQuery> make_queries(size_t n, glm::vec3 lo, glm::vec3 hi, uint64_t seed) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
@@ -134,7 +131,7 @@ int main(int argc, char** argv) try {
         rows.push_back(std::move(r));
     }
     // Where the cooperative-matrix query's time goes: features only, MLP only.
-    double ms_features = 0, ms_mlp = 0, ms_levels[2] = {0, 0};
+    double ms_features = 0, ms_mlp = 0;
     if (why.empty()) {
         NeuralEvaluator fe(ctx, gpu, choose_neural_kernel(dev, NeuralPath::coopmat), 1);
         fe.evaluate(qs);
@@ -144,13 +141,6 @@ int main(int argc, char** argv) try {
         ms_mlp = me.time_dispatch(uint32_t(qs.size()), reps);
         std::printf("coopmat breakdown: hash-grid features only %.3f ms (%.3f G/s), MLP only %.3f ms (%.3f G/s)\n",
                     ms_features, qs.size() / (ms_features * 1e6), ms_mlp, qs.size() / (ms_mlp * 1e6));
-        for (uint32_t part : {3u, 4u}) {
-            NeuralEvaluator pe(ctx, gpu, choose_neural_kernel(dev, NeuralPath::coopmat), part);
-            pe.evaluate(qs);
-            ms_levels[part - 3] = pe.time_dispatch(uint32_t(qs.size()), reps);
-        }
-        std::printf("coopmat features by level group: levels %u.. only %.3f ms, levels 0..%u only %.3f ms\n",
-                    NB_GATHER_LEVELS_HOST, ms_levels[0], NB_GATHER_LEVELS_HOST - 1, ms_levels[1]);
     }
     std::string agree = "[";
     for (size_t k = 1; k < rows.size(); ++k) {
@@ -192,8 +182,6 @@ int main(int argc, char** argv) try {
             f << (i ? ", " : "") << "{\"path\": \"" << rows[i].path << "\", \"ms\": " << rows[i].ms
               << ", \"queries_per_s\": " << rows[i].qps << "}";
         f << "],\n  \"coopmat_features_only_ms\": " << ms_features << ",\n  \"coopmat_mlp_only_ms\": " << ms_mlp
-          << ",\n  \"coopmat_features_hashed_levels_only_ms\": " << ms_levels[0]
-          << ",\n  \"coopmat_features_first_levels_only_ms\": " << ms_levels[1]
           << ",\n  \"scalar_vs_coopmat\": " << agree << "\n}\n";
     }
     return 0;
