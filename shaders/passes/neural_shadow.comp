@@ -51,9 +51,16 @@ void main() {
     g_nl_skip_triangles = op != 0u;
     nb_trace(org, dir, 0.0f, tmax, true);
     if (op == 0u && g_hit_instance != NB_NO_HIT) {
-        st.best_t = g_tmax; // a triangle occludes
-        st.status = NB_NRAY_DONE;
-    } else if (!nb_nl_queue_candidate(cap + i, half_, tmax, st)) {
+        // A triangle occludes. Done in the first traversal: shadow.comp reads only best_t, and op 1 only
+        // rays with queued pairs, so one word is stored, not the 64-byte record.
+        neural_state[cap + i].best_t = g_tmax;
+        return;
+    }
+    if (!nb_nl_queue_candidate(cap + i, half_, tmax, st)) {
+        if (op == 0u) { // no leaf in front of tmax: not occluded (same reasoning)
+            neural_state[cap + i].best_t = NB_INF;
+            return;
+        }
         st.status = NB_NRAY_DONE;
     }
     neural_state[cap + i] = st;

@@ -45,8 +45,8 @@ void main() {
         if (op == 0u && (pc.mode & NB_NL_MODE_SORTED) != 0u) i = rs_order[i]; // passes/ray_sort.comp
         if (op == 2u) {
             if (i == 0u) counters.pending_count = 0u; // nothing queued remains for the shadow loop
+            if (neural_state[i].status == NB_NRAY_DONE) return; // one word: most rays finished in op 0
             st = neural_state[i];
-            if (st.status == NB_NRAY_DONE) return;
             nb_nl_finish_path(i, st);
             neural_state[i] = st;
             return;
@@ -73,6 +73,15 @@ void main() {
         g_nl_skip_triangles = true;
         nb_trace(org, dir, t_resume, min(st.tri_t, st.best_t), false);
     }
-    if (!nb_nl_queue_candidate(i, half_, min(st.tri_t, st.best_t), st)) nb_nl_finish_path(i, st);
+    if (!nb_nl_queue_candidate(i, half_, min(st.tri_t, st.best_t), st)) {
+        nb_nl_finish_path(i, st);
+        // A ray finished by its first traversal has no neural hit (hit SOA as traced): op 2 reads only its
+        // status, nothing else reads its state (neural_surface.glsl only for neural hits), so one word
+        // is stored, not the 64-byte record (every camera ray of the wave passes here).
+        if (op == 0u) {
+            neural_state[i].status = NB_NRAY_DONE;
+            return;
+        }
+    }
     neural_state[i] = st;
 }
