@@ -169,7 +169,6 @@ std::vector<std::string> pass_list(const SceneFeatures& f, const NeuralPlan* neu
     std::vector<std::string> passes = {"passes/camera_rays.comp", "passes/queue_args.comp"};
     if (n) {
         neural_rounds(passes, *n, "passes/neural_traverse.comp");
-        passes.push_back("passes/neural_traverse.comp"); // op 2: closest hit of triangles and neural leaves
     } else {
         passes.push_back("passes/ray_sort.comp"); // secondary rays (RenderOptions::sort_rays)
         passes.push_back("passes/traverse.comp");
@@ -230,7 +229,6 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
     s += "    passes/queue_args.comp     ray counter -> indirect dispatch arguments\n";
     if (n) {
         s += neural_rounds_text(*n, "passes/neural_traverse.comp", "closest hit through triangles and N-BVHs");
-        s += "    passes/neural_traverse.comp  op 2: closest of triangle and accepted neural hits (indirect)\n";
     } else {
         s += "    passes/ray_sort.comp       bounces > 0: rays in (direction octant, origin cell) order (--sort-rays)\n";
         s += "    passes/traverse.comp       TLAS/BLAS closest hit (indirect)\n";

@@ -4,7 +4,7 @@
 //
 // Per path-ray bounce the renderer records (engine/render/README.md):
 //   neural_traverse(op 0, all rays) -> [neural_args -> neural_query -> neural_traverse(op 1, the rays
-//   just queried)] x batched rounds -> neural_args -> neural_tail -> neural_traverse(op 2) -> shade
+//   just queried)] x batched rounds -> neural_args -> neural_tail -> shade
 // instead of traverse, and for shadow rays
 //   neural_shadow(op 0) -> [neural_args -> neural_query -> neural_shadow(op 1)] x batched rounds
 //   -> neural_args -> neural_tail -> shadow

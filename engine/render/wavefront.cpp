@@ -365,7 +365,6 @@ void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, const Wave& w
         if (hybrid_) {
             // Closest hits through triangles and neural leaves: queue a pair per ray, query, resume.
             record_neural_rounds(cmd, NEURAL_TRAVERSE, q, depth, w);
-            record_pass(cmd, NEURAL_TRAVERSE, constants(q, depth, w, 2), Dispatch::indirect_rays);
         } else {
             const bool sort = record_ray_sort(cmd, q, depth, w, false);
             record_pass(cmd, TRAVERSE, constants(q, depth, w, sort ? NB_TRAVERSE_MODE_SORTED : 0u), Dispatch::indirect_rays);
@@ -565,7 +564,6 @@ std::vector<TraceHit> WavefrontRenderer::trace(const std::vector<glm::vec3>& ori
         record_pass(cmd_, QUEUE_ARGS, constants(0, 0, Wave{0, 1, 0, n}, NB_ARGS_MODE_RAYS), Dispatch::single);
         if (hybrid_) { // as record_sample_wave at depth 0
             record_neural_rounds(cmd_, NEURAL_TRAVERSE, 0, 0, Wave{0, 1, 0, n});
-            record_pass(cmd_, NEURAL_TRAVERSE, constants(0, 0, Wave{0, 1, 0, n}, 2), Dispatch::indirect_rays);
         } else {
             record_pass(cmd_, TRAVERSE, constants(0, 0, Wave{0, 1, 0, n}, 0), Dispatch::indirect_rays);
         }

@@ -87,5 +87,9 @@ void main() {
         float t = nb_tail_query(r, n, a);
         nb_nl_take_hit(st, t, n, a, r.pl.instance, r.pl.leaf);
     }
+    // Not reached: each turn above spends one leaf of the budget, and the turn after the last one
+    // returns. Finished here all the same, so that no ray leaves the tail undecided.
+    if (shadow) st.status = NB_NRAY_DONE;
+    else nb_nl_finish_path(i, st);
     neural_state[ray] = st;
 }

@@ -6,11 +6,11 @@
 //      over them; the first pair of each ray's group): apply the group's hits in key order, re-traverse
 //      the neural instances only (triangles are known), culled by min(triangle hit, best neural hit),
 //      and queue the next leaves into half nb_nl_half(pc.mode) (a ray whose group was its last,
-//      NB_NRAY_PENDING_LAST, is finished without re-traversal);
-//   2: every ray: rays still undecided keep the best hit found so far (safety net: after the last
-//      batched round passes/neural_tail.comp finishes every ray).
+//      NB_NRAY_PENDING_LAST, is finished without re-traversal).
 // A ray is finished when no leaf key remains in front of its best hit; then a closer neural hit
-// replaces the triangle hit in the hit SOA (triangle word NB_NEURAL_TRIANGLE).
+// replaces the triangle hit in the hit SOA (triangle word NB_NEURAL_TRIANGLE). Every ray is finished by
+// op 0, an op 1 or passes/neural_tail.comp (the rays of the pairs the last round queued): shade reads
+// the hit SOA next.
 #version 460
 #include "lib/bindings.glsl"
 #include "lib/traverse.glsl"
@@ -42,15 +42,7 @@ void main() {
     } else {
         i = gl_GlobalInvocationID.x;
         if (i >= queue_count(q)) return;
-        if (op == 0u && (pc.mode & NB_NL_MODE_SORTED) != 0u) i = rs_order[i]; // passes/ray_sort.comp
-        if (op == 2u) {
-            if (i == 0u) counters.pending_count = 0u; // nothing queued remains for the shadow loop
-            if (neural_state[i].status == NB_NRAY_DONE) return; // one word: most rays finished in op 0
-            st = neural_state[i];
-            nb_nl_finish_path(i, st);
-            neural_state[i] = st;
-            return;
-        }
+        if ((pc.mode & NB_NL_MODE_SORTED) != 0u) i = rs_order[i]; // passes/ray_sort.comp
         st = nb_nl_fresh_state();
     }
     vec3 org = ray_load3(q, NB_RAY_ORIGIN, i);
@@ -74,14 +66,11 @@ void main() {
         nb_trace(org, dir, t_resume, min(st.tri_t, st.best_t), false);
     }
     if (!nb_nl_queue_candidate(i, half_, min(st.tri_t, st.best_t), st)) {
+        // A ray finished by its first traversal has no neural hit (the hit SOA holds what it traced) and
+        // nothing reads its state (neural_surface.glsl reads neural hits only, op 1 and the tail the rays
+        // of queued pairs): nothing is stored (every camera ray of the wave passes here).
+        if (op == 0u) return;
         nb_nl_finish_path(i, st);
-        // A ray finished by its first traversal has no neural hit (hit SOA as traced): op 2 reads only its
-        // status, nothing else reads its state (neural_surface.glsl only for neural hits), so one word
-        // is stored, not the 64-byte record (every camera ray of the wave passes here).
-        if (op == 0u) {
-            neural_state[i].status = NB_NRAY_DONE;
-            return;
-        }
     }
     neural_state[i] = st;
 }
