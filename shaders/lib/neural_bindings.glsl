@@ -40,9 +40,9 @@ uint nb_nl_pending_index(uint half_, uint k) { return half_ * nb_nl_half_size() 
     DST.t_enter = SRC.t_enter;                                                                        \
     DST.t_exit = SRC.t_exit;                                                                          \
     DST.group = SRC.group;                                                                            \
-    DST.hit_t = SRC.hit_t;                                                                            \
-    DST.hit_normal = SRC.hit_normal;                                                                  \
-    DST.hit_albedo = SRC.hit_albedo;
+    DST.t = SRC.t;                                                                                    \
+    DST.a = SRC.a;                                                                                    \
+    DST.b = SRC.b;
 GpuPendingLeaf nb_pending_load(uint slot) {
     uint hs = nb_nl_half_size();
     GpuPendingLeaf pl;
@@ -65,13 +65,13 @@ void nb_pending_store(uint slot, GpuPendingLeaf pl) {
 void nb_pending_set_hit(uint slot, float t, vec3 normal, vec3 albedo) {
     uint hs = nb_nl_half_size();
     if (slot < hs) {
-        pending_leaves[slot].hit_t = t;
-        pending_leaves[slot].hit_normal = normal;
-        pending_leaves[slot].hit_albedo = albedo;
+        pending_leaves[slot].t = t;
+        pending_leaves[slot].a = normal;
+        pending_leaves[slot].b = albedo;
     } else {
-        pending_leaves_1[slot - hs].hit_t = t;
-        pending_leaves_1[slot - hs].hit_normal = normal;
-        pending_leaves_1[slot - hs].hit_albedo = albedo;
+        pending_leaves_1[slot - hs].t = t;
+        pending_leaves_1[slot - hs].a = normal;
+        pending_leaves_1[slot - hs].b = albedo;
     }
 }
 

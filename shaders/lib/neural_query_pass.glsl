@@ -27,16 +27,16 @@ NbPendingQuery nb_load_pending(uint k) {
     r.pl.leaf = 0u;
     r.pl.t_enter = 0.0f;
     r.pl.t_exit = 0.0f;
+    r.pl.group = 0u;
+    r.pl.t = 0.0f;
+    r.pl.a = vec3(0.0f);
+    r.pl.b = vec3(0.0f, 0.0f, 1.0f);
     if (!r.valid) return r;
-    uint cap = ray_capacity();
     r.slot = nb_nl_pending_index((pc.mode >> 2u) & 1u, k);
-    r.pl = nb_pending_load(r.slot);
+    r.pl = nb_pending_load(r.slot); // queued, not yet answered: t, a, b are the ray's bound, origin, direction
     GpuInstance inst = instances[r.pl.instance];
-    bool shadow = r.pl.ray >= cap;
-    vec3 o = shadow ? shadow_load3(NB_SHADOW_ORIGIN, r.pl.ray - cap) : ray_load3(pc.in_queue, NB_RAY_ORIGIN, r.pl.ray);
-    vec3 d = shadow ? shadow_load3(NB_SHADOW_DIR, r.pl.ray - cap) : ray_load3(pc.in_queue, NB_RAY_DIR, r.pl.ray);
-    r.org = nb_xform_point(inst.world_to_object, o);
-    r.dir = nb_xform_vector(inst.world_to_object, d);
+    r.org = nb_xform_point(inst.world_to_object, r.pl.a);
+    r.dir = nb_xform_vector(inst.world_to_object, r.pl.b);
     return r;
 }
 
@@ -66,13 +66,10 @@ bool nb_neural_covers(NbPendingQuery r, bool shadow, float visibility, bool thre
 float nb_neural_pair_hit(NbPendingQuery r, float y[NB_MLP_OUTPUTS], out vec3 normal, out vec3 albedo) {
     GpuNeuralHit h = nb_neural_decode(neural_params.box, y, r.pl.t_enter, r.pl.t_exit, length(r.dir),
                                       neural_params.threshold);
-    uint ray = r.pl.ray;
-    uint cap = ray_capacity();
-    bool shadow = ray >= cap;
-    float tmin = shadow ? 0.0f : uintBitsToFloat(ray_load1(pc.in_queue, NB_RAY_T_RESUME, ray));
-    float tmax = shadow ? uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, ray - cap)) : NB_INF;
-    bool flagged = ((shadow ? shadow_load1(NB_SHADOW_PIXEL, ray - cap) : ray_load1(pc.in_queue, NB_RAY_DEPTH, ray)) &
-                    NB_RAY_BACKFACE_BIT) != 0u;
+    bool shadow = r.pl.ray >= ray_capacity();
+    float tmin = shadow ? 0.0f : r.pl.t; // the bound the pair was queued with (GpuPendingLeaf)
+    float tmax = shadow ? r.pl.t : NB_INF;
+    bool flagged = (r.pl.group & NB_RAY_BACKFACE_BIT) != 0u;
     normal = vec3(0.0f, 0.0f, 1.0f);
     albedo = h.albedo;
     bool visible = (h.flags & NB_NEURAL_VISIBLE) != 0u;

@@ -128,7 +128,10 @@ uint nb_nl_want(GpuNeuralRayState st) {
 
 // Queues the candidates of the last traversal in front of `limit` (within the ray's leaf budget),
 // contiguously in key order, into half `half` of the pending queue; returns false when the ray is finished.
-bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, inout GpuNeuralRayState st) {
+// The pairs carry the query's inputs (GpuPendingLeaf): the ray's world origin and direction, its t
+// bound (path rays: tmin; shadow rays: tmax) and its back-face flag (`flag_word`'s NB_RAY_BACKFACE_BIT).
+bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, vec3 org, vec3 dir, float t_bound,
+                           uint flag_word, inout GpuNeuralRayState st) {
     uint n = 0u;
     while (n < g_nl_cand_n && g_nl_cand_t[n] < limit) n += 1u;
     if (n == 0u) return false;
@@ -144,10 +147,10 @@ bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, inout GpuN
         pl.leaf = g_nl_cand_leaf[j];
         pl.t_enter = g_nl_cand_entry[j];
         pl.t_exit = g_nl_cand_exit[j];
-        pl.group = j == 0u ? n : 0u;
-        pl.hit_t = NB_INF;
-        pl.hit_normal = vec3(0.0f, 0.0f, 1.0f);
-        pl.hit_albedo = vec3(0.0f);
+        pl.group = (j == 0u ? n : 0u) | (flag_word & NB_RAY_BACKFACE_BIT);
+        pl.t = t_bound;
+        pl.a = org;
+        pl.b = dir;
         nb_pending_store(nb_nl_pending_index(half_, k + j), pl);
     }
     st.key_t = g_nl_cand_t[n - 1u];
@@ -188,7 +191,7 @@ bool nb_nl_is_pending(uint status) { return status == NB_NRAY_PENDING || status 
 void nb_nl_reduce_group(uint slot, uint group, inout GpuNeuralRayState st) {
     for (uint j = 0u; j < group; ++j) {
         GpuPendingLeaf pl = nb_pending_load(slot + j);
-        nb_nl_take_hit(st, pl.hit_t, pl.hit_normal, pl.hit_albedo, pl.instance, pl.leaf);
+        nb_nl_take_hit(st, pl.t, pl.a, pl.b, pl.instance, pl.leaf); // the answered pair
     }
     st.status = NB_NRAY_TRACE;
 }

@@ -23,12 +23,12 @@ void main() {
         if (k >= neural_counters.pending_active) return;
         uint slot = nb_nl_pending_index(half_ ^ 1u, k);
         GpuPendingLeaf pl = nb_pending_load(slot);
-        if (pl.group == 0u) return; // the first pair of the ray's group resumes it
+        if (nb_pair_group(pl.group) == 0u) return; // the first pair of the ray's group resumes it
         i = pl.ray - cap;
         st = neural_state[cap + i];
         if (!nb_nl_is_pending(st.status)) return;
         bool last = st.status == NB_NRAY_PENDING_LAST;
-        nb_nl_reduce_group(slot, pl.group, st);
+        nb_nl_reduce_group(slot, nb_pair_group(pl.group), st);
         // An occluder found, or no leaf left (also when the last key lies at or beyond the shadow ray's
         // end): done without re-traversal.
         if (last || st.best_t < NB_INF ||
@@ -56,7 +56,7 @@ void main() {
         neural_state[cap + i].best_t = g_tmax;
         return;
     }
-    if (!nb_nl_queue_candidate(cap + i, half_, tmax, st)) {
+    if (!nb_nl_queue_candidate(cap + i, half_, tmax, org, dir, tmax, shadow_load1(NB_SHADOW_PIXEL, i), st)) {
         if (op == 0u) { // no leaf in front of tmax: not occluded (same reasoning)
             neural_state[cap + i].best_t = NB_INF;
             return;

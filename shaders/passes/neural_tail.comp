@@ -24,7 +24,7 @@ float nb_tail_query(NbPendingQuery r, out vec3 normal, out vec3 albedo) {
 
 void main() {
     NbPendingQuery r = nb_load_pending(gl_GlobalInvocationID.x);
-    if (!r.valid || r.pl.group == 0u) return; // the first pair of each ray's group finishes the ray
+    if (!r.valid || nb_pair_group(r.pl.group) == 0u) return; // the first pair of each ray's group finishes the ray
     uint cap = ray_capacity();
     uint ray = r.pl.ray;
     bool shadow = ray >= cap;
@@ -39,7 +39,7 @@ void main() {
     GpuNeuralRayState st = neural_state[ray];
     bool last = st.status == NB_NRAY_PENDING_LAST; // no leaf left behind this group
     // The group queued by the last batched round, in key order.
-    uint group = r.pl.group;
+    uint group = nb_pair_group(r.pl.group);
     for (uint j = 0u; j < group; ++j) {
         NbPendingQuery rj = j == 0u ? r : nb_load_pending(gl_GlobalInvocationID.x + j);
         vec3 n, a;

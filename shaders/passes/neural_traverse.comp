@@ -28,12 +28,12 @@ void main() {
         if (k >= neural_counters.pending_active) return;
         uint slot = nb_nl_pending_index(half_ ^ 1u, k);
         GpuPendingLeaf pl = nb_pending_load(slot);
-        if (pl.group == 0u) return; // the first pair of the ray's group resumes it
+        if (nb_pair_group(pl.group) == 0u) return; // the first pair of the ray's group resumes it
         i = pl.ray;
         st = neural_state[i];
         if (!nb_nl_is_pending(st.status)) return;
         bool last = st.status == NB_NRAY_PENDING_LAST;
-        nb_nl_reduce_group(slot, pl.group, st);
+        nb_nl_reduce_group(slot, nb_pair_group(pl.group), st);
         if (last || !nb_nl_may_have_more(st, min(st.tri_t, st.best_t))) { // nothing left in front: no re-traversal
             nb_nl_finish_path(i, st);
             neural_state[i] = st;
@@ -65,7 +65,7 @@ void main() {
         g_nl_skip_triangles = true;
         nb_trace(org, dir, t_resume, min(st.tri_t, st.best_t), false);
     }
-    if (!nb_nl_queue_candidate(i, half_, min(st.tri_t, st.best_t), st)) {
+    if (!nb_nl_queue_candidate(i, half_, min(st.tri_t, st.best_t), org, dir, t_resume, ray_load1(q, NB_RAY_DEPTH, i), st)) {
         // A ray finished by its first traversal has no neural hit (the hit SOA holds what it traced) and
         // nothing reads its state (neural_surface.glsl reads neural hits only, op 1 and the tail the rays
         // of queued pairs): nothing is stored (every camera ray of the wave passes here).

@@ -68,14 +68,20 @@ struct GpuPendingLeaf {
     float t_enter;  // leaf interval along the ray (world t)
     float t_exit;
     // A ray queues up to GpuNeuralParams.leaves_per_round pairs per round, contiguously, in key order:
-    // the first one holds their count (its resumed traversal reduces them), the others 0.
+    // the first one holds their count (its resumed traversal reduces them), the others 0 (nb_pair_group);
+    // bit 31 (NB_RAY_BACKFACE_BIT) set: the ray's query skips back-facing hits (every pair of the ray).
     uint group;
-    // Written by the query pass: the accepted hit of this pair (hit_t NB_INF: none), world space.
-    float hit_t;
-    vec3 hit_normal;
-    vec3 hit_albedo;
+    // The last 7 words serve two phases. Queued (by the traversal): the query's inputs, so that the
+    // query pass reads them here, in queue order, instead of from the ray queues at scattered slots:
+    // t = the ray's bound (path rays: their tmin, NB_RAY_T_RESUME; shadow rays: their tmax), a / b = its
+    // world-space origin / direction. Answered (by the query pass, for the resumed traversal): the
+    // accepted hit of this pair (t NB_INF: none), a / b = its world-space normal / albedo.
+    float t;
+    vec3 a;
+    vec3 b;
 };
 NB_STATIC_ASSERT(sizeof(GpuPendingLeaf) == 52, "GpuPendingLeaf layout");
+NB_FN uint nb_pair_group(uint group) { return group & ~NB_RAY_BACKFACE_BIT; }
 
 // ---- Queue counters and indirect arguments -------------------------------------------------------
 struct GpuDispatchArgs {
