@@ -106,6 +106,10 @@ void shadow_store3(uint field, uint i, vec3 v) {
 }
 uint shadow_load1(uint field, uint i) { return shadow_words[nb_shadow_word(field, ray_capacity(), i, 1u)]; }
 void shadow_store1(uint field, uint i, uint v) { shadow_words[nb_shadow_word(field, ray_capacity(), i, 1u)] = v; }
+// Hybrid renders: neural_shadow's decision "occluded" is a negative NB_SHADOW_TMAX (a shadow ray's own
+// tmax is positive), read by shadow.comp together with the rest of the ray.
+void nb_shadow_mark_occluded(uint i) { shadow_store1(NB_SHADOW_TMAX, i, floatBitsToUint(-1.0f)); }
+bool nb_shadow_is_marked_occluded(float tmax) { return tmax < 0.0f; }
 
 // Random bits of a ray's stochastic alpha coverage (shared/scene_gpu.h nb_alpha_covers): a path ray's
 // are its NB_RAY_RNG word; a shadow ray's come from its path's slot in the wave (pixel, sample, depth).

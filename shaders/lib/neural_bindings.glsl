@@ -61,17 +61,23 @@ void nb_pending_store(uint slot, GpuPendingLeaf pl) {
         NB_PENDING_COPY(pending_leaves_1[slot - hs], pl)
     }
 }
-// The query pass's result of a pair.
+// The query pass's result of a pair. A miss (t NB_INF) stores t only: the resumed traversal takes a
+// pair's normal and albedo only from a hit in front of its best one (nb_nl_take_hit).
 void nb_pending_set_hit(uint slot, float t, vec3 normal, vec3 albedo) {
     uint hs = nb_nl_half_size();
+    bool hit = t < NB_INF;
     if (slot < hs) {
         pending_leaves[slot].t = t;
-        pending_leaves[slot].a = normal;
-        pending_leaves[slot].b = albedo;
+        if (hit) {
+            pending_leaves[slot].a = normal;
+            pending_leaves[slot].b = albedo;
+        }
     } else {
         pending_leaves_1[slot - hs].t = t;
-        pending_leaves_1[slot - hs].a = normal;
-        pending_leaves_1[slot - hs].b = albedo;
+        if (hit) {
+            pending_leaves_1[slot - hs].a = normal;
+            pending_leaves_1[slot - hs].b = albedo;
+        }
     }
 }
 

@@ -129,9 +129,10 @@ uint nb_nl_want(GpuNeuralRayState st) {
 // Queues the candidates of the last traversal in front of `limit` (within the ray's leaf budget),
 // contiguously in key order, into half `half` of the pending queue; returns false when the ray is finished.
 // The pairs carry the query's inputs (GpuPendingLeaf): the ray's world origin and direction, its t
-// bound (path rays: tmin; shadow rays: tmax) and its back-face flag (`flag_word`'s NB_RAY_BACKFACE_BIT).
+// bound (path rays: tmin; shadow rays: tmax) and its back-face flag (read here, only for rays that
+// queue: NB_RAY_BACKFACE_BIT of a path ray's NB_RAY_DEPTH word, of a shadow ray's NB_SHADOW_PIXEL word).
 bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, vec3 org, vec3 dir, float t_bound,
-                           uint flag_word, inout GpuNeuralRayState st) {
+                           inout GpuNeuralRayState st) {
     uint n = 0u;
     while (n < g_nl_cand_n && g_nl_cand_t[n] < limit) n += 1u;
     if (n == 0u) return false;
@@ -139,6 +140,9 @@ bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, vec3 org, 
         atomicAdd(neural_counters.leaf_cap_rays, 1u);
         return false;
     }
+    uint cap = ray_capacity();
+    uint flag = (state_index >= cap ? shadow_load1(NB_SHADOW_PIXEL, state_index - cap)
+                                    : ray_load1(pc.in_queue, NB_RAY_DEPTH, state_index)) & NB_RAY_BACKFACE_BIT;
     uint k = atomicAdd(counters.pending_count, n);
     for (uint j = 0u; j < n; ++j) {
         GpuPendingLeaf pl;
@@ -147,7 +151,7 @@ bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, vec3 org, 
         pl.leaf = g_nl_cand_leaf[j];
         pl.t_enter = g_nl_cand_entry[j];
         pl.t_exit = g_nl_cand_exit[j];
-        pl.group = (j == 0u ? n : 0u) | (flag_word & NB_RAY_BACKFACE_BIT);
+        pl.group = (j == 0u ? n : 0u) | flag;
         pl.t = t_bound;
         pl.a = org;
         pl.b = dir;

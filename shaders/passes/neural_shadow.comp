@@ -1,6 +1,8 @@
 // Neural visibility of shadow rays (hybrid renders), before passes/shadow.comp: the same ordered leaf
 // search and batched queries as path rays (passes/neural_traverse.comp), with any-hit semantics. The
-// state of shadow ray i lives at neural_state[capacity + i]; its best_t < NB_INF means "occluded".
+// state of shadow ray i lives at neural_state[capacity + i] while its leaves are queried; the decision
+// "occluded" goes to the ray's own NB_SHADOW_TMAX word (nb_shadow_mark_occluded), which shadow.comp
+// reads anyway: a ray found unoccluded stores nothing.
 //   op 0: every shadow ray: triangle any-hit (occluded -> done), else queue the first neural leaf;
 //   op 1: the rays of the pairs just queried (first pair of each ray's group): any accepted hit of the
 //         group -> occluded, done; the group was the ray's last -> not occluded, done; else queue the
@@ -35,6 +37,7 @@ void main() {
             !nb_nl_may_have_more(st, uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, pl.ray - cap)))) {
             st.status = NB_NRAY_DONE;
             neural_state[cap + i] = st;
+            if (st.best_t < NB_INF) nb_shadow_mark_occluded(i);
             return;
         }
     } else {
@@ -50,17 +53,14 @@ void main() {
     nb_nl_begin(st, neural_params.lod_secondary, nb_nl_want(st));
     g_nl_skip_triangles = op != 0u;
     nb_trace(org, dir, 0.0f, tmax, true);
-    if (op == 0u && g_hit_instance != NB_NO_HIT) {
-        // A triangle occludes. Done in the first traversal: shadow.comp reads only best_t, and op 1 only
-        // rays with queued pairs, so one word is stored, not the 64-byte record.
-        neural_state[cap + i].best_t = g_tmax;
+    if (op == 0u && g_hit_instance != NB_NO_HIT) { // a triangle occludes: decided in the first traversal
+        nb_shadow_mark_occluded(i);
         return;
     }
-    if (!nb_nl_queue_candidate(cap + i, half_, tmax, org, dir, tmax, shadow_load1(NB_SHADOW_PIXEL, i), st)) {
-        if (op == 0u) { // no leaf in front of tmax: not occluded (same reasoning)
-            neural_state[cap + i].best_t = NB_INF;
-            return;
-        }
+    if (!nb_nl_queue_candidate(cap + i, half_, tmax, org, dir, tmax, st)) {
+        // No leaf in front of tmax: not occluded. A ray decided by its first traversal stores nothing
+        // (op 1 and the tail read only the states of rays with queued pairs).
+        if (op == 0u) return;
         st.status = NB_NRAY_DONE;
     }
     neural_state[cap + i] = st;

@@ -50,6 +50,7 @@ void main() {
         if (shadow && st.best_t < NB_INF) { // occluded
             st.status = NB_NRAY_DONE;
             neural_state[ray] = st;
+            nb_shadow_mark_occluded(i);
             return;
         }
         float limit = shadow ? tmax : min(st.tri_t, st.best_t);
@@ -89,7 +90,11 @@ void main() {
     }
     // Not reached: each turn above spends one leaf of the budget, and the turn after the last one
     // returns. Finished here all the same, so that no ray leaves the tail undecided.
-    if (shadow) st.status = NB_NRAY_DONE;
-    else nb_nl_finish_path(i, st);
+    if (shadow) {
+        st.status = NB_NRAY_DONE;
+        if (st.best_t < NB_INF) nb_shadow_mark_occluded(i);
+    } else {
+        nb_nl_finish_path(i, st);
+    }
     neural_state[ray] = st;
 }

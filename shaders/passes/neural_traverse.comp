@@ -65,7 +65,7 @@ void main() {
         g_nl_skip_triangles = true;
         nb_trace(org, dir, t_resume, min(st.tri_t, st.best_t), false);
     }
-    if (!nb_nl_queue_candidate(i, half_, min(st.tri_t, st.best_t), org, dir, t_resume, ray_load1(q, NB_RAY_DEPTH, i), st)) {
+    if (!nb_nl_queue_candidate(i, half_, min(st.tri_t, st.best_t), org, dir, t_resume, st)) {
         // A ray finished by its first traversal has no neural hit (the hit SOA holds what it traced) and
         // nothing reads its state (neural_surface.glsl reads neural hits only, op 1 and the tail the rays
         // of queued pairs): nothing is stored (every camera ray of the wave passes here).

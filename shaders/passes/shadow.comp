@@ -17,9 +17,10 @@ void main() {
     g_alpha_seed = nb_shadow_alpha_seed(slot);
     bool occluded;
     if (NB_HAS_NEURAL && (pc.mode & NB_SHADOW_MODE_HYBRID) != 0u) {
-        // Hybrid render: passes/neural_shadow.comp decided (triangles and neural leaves). A renderer
-        // with a model switched to its classical reference traces here (engine/render/wavefront.h apply).
-        occluded = neural_state[ray_capacity() + i].best_t < NB_INF;
+        // Hybrid render: passes/neural_shadow.comp decided (triangles and neural leaves) and marked the
+        // occluded rays (nb_shadow_mark_occluded). A renderer with a model switched to its classical
+        // reference traces here (engine/render/wavefront.h apply).
+        occluded = nb_shadow_is_marked_occluded(tmax);
     } else {
         nb_trace(org, dir, 0.0f, tmax, true);
         occluded = g_hit_instance != NB_NO_HIT;
