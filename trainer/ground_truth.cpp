@@ -75,14 +75,10 @@ bool blended_back_face(const TrainingAsset& asset, const Material& material, uin
     return nb_back_facing(m.positions[idx[0]], m.positions[idx[1]], m.positions[idx[2]], dir);
 }
 
-} // namespace
-
-namespace {
-
 // Whether a hit at barycentrics (u, v) of triangle `tri` (original index, its `material`), on a ray
 // along `dir`, counts (ground_truth.h).
 bool alpha_covers(const TrainingAsset& asset, const Material* material, uint32_t tri, float u, float v,
-                     const glm::vec3& dir, const SampleSlot& key) {
+                  const glm::vec3& dir, const SampleSlot& key) {
     if (!material || material->alpha_mode == AlphaMode::opaque) return true;
     if (blended_back_face(asset, *material, tri, dir)) return false;
     return nb_alpha_covers(uint32_t(material->alpha_mode), surface_alpha(asset, *material, tri, u, v),

@@ -53,8 +53,8 @@ NB_FN float nb_target_entropy(float t) {
 NB_FN float nb_loss_bce(float y, float t, NB_OUT(float) d) {
     const float p = fminf(fmaxf(y, NB_BCE_CLAMP), 1.0f - NB_BCE_CLAMP);
     d = -(t - p) / (p * (1.0f - p));
-    const float bce = -(t * logf(p) + (1.0f - t) * logf(1.0f - p));
-    return (t > 0.0f && t < 1.0f) ? fmaxf(bce - nb_target_entropy(t), 0.0f) : bce;
+    // Minus the target's entropy (0 for t = 0 or 1, where the BCE itself is >= 0: the same value).
+    return fmaxf(-(t * logf(p) + (1.0f - t) * logf(1.0f - p)) - nb_target_entropy(t), 0.0f);
 }
 NB_FN float nb_loss_l1(float y, float t, NB_OUT(float) d) {
     const float e = y - t;
