@@ -30,6 +30,7 @@ float g_nl_cand_entry[NB_NL_MAX_LEAVES_PER_ROUND];
 float g_nl_cand_exit[NB_NL_MAX_LEAVES_PER_ROUND];
 uint g_nl_inst = 0u;              // instance being walked
 float g_nl_walk_tmax = NB_INF;    // the ray's limit (best hit) during a walk; g_tmax culls the walk's nodes
+float g_nl_ray_tmin = 0.0f;       // the ray's tmin during a walk; g_tmin culls the walk's nodes
 vec3 g_nl_inv_dir;
 
 bool nb_nl_key_less(float ta, uint ia, uint la, float tb, uint ib, uint lb) {
@@ -61,8 +62,8 @@ void nb_neural_leaf(uint first, uint count) {
         float te, tx;
         vec3 lo = nbvh_bounds[2u * node], hi = nbvh_bounds[2u * node + 1u];
         if (!nb_neural_leaf_interval(g_obj_org, g_nl_inv_dir, lo, hi, te, tx)) continue;
-        if (!(tx > g_tmin)) continue; // the leaf lies behind the ray's start
-        float key = max(te, g_tmin);
+        if (!(tx > g_nl_ray_tmin)) continue; // the leaf lies behind the ray's start
+        float key = max(te, g_nl_ray_tmin);
         if (!(key < g_nl_walk_tmax)) continue;
         if (!nb_nl_key_less(g_nl_last_t, g_nl_last_inst, g_nl_last_leaf, key, g_nl_inst, node)) continue;
         if (g_nl_cand_n == g_nl_want) {
@@ -110,7 +111,15 @@ void nb_traverse_neural_instance(uint instance) {
     float saved_tmax = g_tmax;
     g_nl_walk_tmax = saved_tmax;
     g_tmax = min(g_tmax, nb_nl_bound_t());
+    // A resumed walk also culls the subtrees the ray leaves before its last queued key: their leaves
+    // exit before it (node boxes contain their dilated leaves and slab exits are monotonic in the box,
+    // shared/neural_gpu.h nb_neural_cull_bounds), so every key there (<= the leaf's exit) lies below the
+    // last one and was queued or skipped already. Leaves are keyed against the ray's own tmin.
+    float saved_tmin = g_tmin;
+    g_nl_ray_tmin = saved_tmin;
+    g_tmin = max(g_tmin, g_nl_last_t);
     NB_TRAVERSE_BVH(nbvh_nodes, root, g_obj_org, g_nl_inv_dir, nb_neural_leaf)
+    g_tmin = saved_tmin;
     g_tmax = saved_tmax;
 }
 
