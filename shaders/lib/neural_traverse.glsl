@@ -16,6 +16,7 @@
 #include "shared/neural_occupancy.h"
 
 bool g_nl_skip_triangles = false; // resumed rounds: the triangle hit of round 0 is already known
+bool g_nl_skip_neural = false;    // shadow rays' first round: the triangles' any-hit walk alone
 uint g_nl_lod = 0u;               // N-BVH cut (LoD) of this ray
 float g_nl_last_t = -NB_INF;      // last queued key (exclusive lower bound)
 uint g_nl_last_inst = 0u;

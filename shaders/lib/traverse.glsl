@@ -131,7 +131,7 @@ void nb_instance_leaf(uint first, uint count) {
         uint kind = instances[instance].kind;
         bool triangles = kind == NB_INSTANCE_TRIANGLES || (kind == NB_INSTANCE_CAMERA_ONLY && g_camera_ray);
         if (triangles && !g_nl_skip_triangles) nb_traverse_triangle_instance(instance);
-        else if (NB_HAS_NEURAL && kind == NB_INSTANCE_NEURAL) nb_traverse_neural_instance(instance);
+        else if (NB_HAS_NEURAL && kind == NB_INSTANCE_NEURAL && !g_nl_skip_neural) nb_traverse_neural_instance(instance);
     }
 }
 

@@ -51,12 +51,22 @@ void main() {
     float tmax = uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, i));
     g_alpha_seed = nb_shadow_alpha_seed(shadow_load1(NB_SHADOW_PIXEL, i) & ~NB_RAY_BACKFACE_BIT);
     nb_nl_begin(st, neural_params.lod_secondary, nb_nl_want(st));
-    g_nl_skip_triangles = op != 0u;
-    nb_trace(org, dir, 0.0f, tmax, true);
-    if (op == 0u && g_hit_instance != NB_NO_HIT) { // a triangle occludes: decided in the first traversal
-        nb_shadow_mark_occluded(i);
-        return;
+    // Triangles first: a ray they occlude walks no N-BVH (in one walk, an N-BVH the TLAS reaches before
+    // the occluding triangles was walked for nothing). Then the neural instances alone. H200, 1080p 16
+    // spp: neural shadow rays 1.07 -> 0.99 ms per sample (default scene), 0.30 -> 0.26 (dragon); the
+    // same split for path rays measured slower on the default scene (traversal 1.89 -> 2.00).
+    if (op == 0u) {
+        g_nl_skip_triangles = false;
+        g_nl_skip_neural = true;
+        nb_trace(org, dir, 0.0f, tmax, true);
+        g_nl_skip_neural = false;
+        if (g_hit_instance != NB_NO_HIT) {
+            nb_shadow_mark_occluded(i);
+            return;
+        }
     }
+    g_nl_skip_triangles = true;
+    nb_trace(org, dir, 0.0f, tmax, true);
     if (!nb_nl_queue_candidate(cap + i, half_, tmax, org, dir, tmax, st)) {
         // No leaf in front of tmax: not occluded. A ray decided by its first traversal stores nothing
         // (op 1 and the tail read only the states of rays with queued pairs).
