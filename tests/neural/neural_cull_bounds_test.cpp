@@ -2,7 +2,9 @@
 // nb_neural_cull_bounds (shared/neural_gpu.h) so that no leaf interval (nb_neural_leaf_interval: the leaf
 // dilated about its centre) starts before its ancestor's box entry. A leaf entered before the node would
 // be culled when the walk narrows its limit to the round's worst kept key, and lost for good (later rounds
-// start behind that key). Hard cases: leaves flush with the node's faces, thin and flat leaves, rays
+// start behind that key). A resumed walk also culls by the ray's last queued key from below (its g_tmin
+// raised to it), which needs the exit side: no leaf interval ends after its ancestor's box exit, so a leaf
+// whose key is at or above the last one is never behind a culled node. Hard cases: leaves flush with the node's faces, thin and flat leaves, rays
 // grazing a face, origins inside the dilation margin, tiny (1e-4) and huge (1e4) boxes, 3e6 offsets.
 #include <gtest/gtest.h>
 
@@ -20,12 +22,12 @@ struct Box {
 
 vec3 lerp3(const Box& b, vec3 f) { return b.lo + (b.hi - b.lo) * f; }
 
-TEST(NeuralCullBounds, NodeEntryNeverAfterADilatedLeafEntry) {
+TEST(NeuralCullBounds, NodeIntervalContainsEveryDilatedLeafInterval) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u01(0.0f, 1.0f);
     const float scales[] = {1.0e-4f, 1.0f, 1.0e4f};
     const vec3 offsets[] = {vec3(0.0f), vec3(3.0e6f, -2.0e6f, 1.0e6f)};
-    uint64_t leaf_hits = 0, lost_with_plain_boxes = 0;
+    uint64_t leaf_hits = 0, lost_with_plain_boxes = 0, exit_lost_with_plain_boxes = 0;
     for (float scale : scales)
         for (vec3 offset : offsets) {
             if (scale < 1.0f && offset.x != 0.0f) continue; // 1e-4 boxes 3e6 away are below float spacing
@@ -61,17 +63,29 @@ TEST(NeuralCullBounds, NodeEntryNeverAfterADilatedLeafEntry) {
                         ASSERT_TRUE(nb_intersect_aabb(org, inv, clo, chi, tmin, key, ne))
                             << "scale " << scale << " trial " << trial << " ray " << r;
                         EXPECT_LE(ne, key);
+                        // The resumed walk's node test when the leaf's key equals the last queued key
+                        // (the walk's tmin raised to it; a leaf of the same key can still follow it in
+                        // key order): the node must be entered at exactly that distance.
+                        ASSERT_TRUE(nb_intersect_aabb(org, inv, clo, chi, key, key, ne))
+                            << "exit side: scale " << scale << " trial " << trial << " ray " << r;
+                        float nn, nx;
+                        ASSERT_TRUE(nb_intersect_aabb_interval(org, inv, clo, chi, -NB_INF, NB_INF, nn, nx));
+                        EXPECT_GE(nx, lx) << "a leaf interval ends after its node's box";
                         // Negative control: the node's own box (what the GPU layout stored before).
-                        float pe;
+                        float pe, pn, px;
                         if (!nb_intersect_aabb(org, inv, node.lo, node.hi, tmin, key, pe)) ++lost_with_plain_boxes;
+                        if (nb_intersect_aabb_interval(org, inv, node.lo, node.hi, -NB_INF, NB_INF, pn, px) && px < lx)
+                            ++exit_lost_with_plain_boxes;
                     }
                 }
             }
         }
     EXPECT_GT(leaf_hits, 50000u);
     EXPECT_GT(lost_with_plain_boxes, 0u) << "the hard cases must include leaves the plain node box would lose";
-    std::printf("%llu leaf intervals, %llu of them lost by the plain node box\n", (unsigned long long)leaf_hits,
-                (unsigned long long)lost_with_plain_boxes);
+    EXPECT_GT(exit_lost_with_plain_boxes, 0u) << "and leaves ending after the plain node box's exit";
+    std::printf("%llu leaf intervals, %llu of them lost by the plain node box (%llu ending after its exit)\n",
+                (unsigned long long)leaf_hits, (unsigned long long)lost_with_plain_boxes,
+                (unsigned long long)exit_lost_with_plain_boxes);
 }
 
 TEST(NeuralCullBounds, GrowthIsSmallAndEmptyBoxesStayEmpty) {
