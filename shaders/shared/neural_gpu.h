@@ -74,9 +74,10 @@ NB_FN bool nb_neural_leaf_interval(vec3 org, vec3 inv_dir, vec3 lo, vec3 hi, NB_
 // neural_model_gpu.cpp): the node box grown by twice the leaf dilation of its extent plus 1e-6 of its
 // largest coordinate (and 1e-30), so that every leaf interval nb_neural_leaf_interval computes below a
 // node (dilated about the leaf's centre, with float rounding) lies inside the node's box. Slab entry
-// distances are monotonic in the box bounds, so a subtree whose box a ray enters after t is entered by
-// none of its leaves before t: the walk may cull by the round's worst kept leaf key (lib/
-// neural_traverse.glsl) without dropping a leaf.
+// and exit distances are monotonic in the box bounds, so a subtree whose box a ray enters after t is
+// entered by none of its leaves before t, and one it leaves before t is left by all of its leaves
+// before t: the walk may cull by the round's worst kept leaf key and, resumed, by the ray's last queued
+// key (lib/neural_traverse.glsl) without dropping a leaf (tests/neural/neural_cull_bounds_test.cpp).
 NB_FN void nb_neural_cull_bounds(NB_INOUT(vec3) lo, NB_INOUT(vec3) hi) {
     vec3 m = max(abs(lo), abs(hi));
     float pad = max(1e-6f * max(m.x, max(m.y, m.z)), 1e-30f);

@@ -3,9 +3,10 @@
 // dilated about its centre) starts before its ancestor's box entry. A leaf entered before the node would
 // be culled when the walk narrows its limit to the round's worst kept key, and lost for good (later rounds
 // start behind that key). A resumed walk also culls by the ray's last queued key from below (its g_tmin
-// raised to it), which needs the exit side: no leaf interval ends after its ancestor's box exit, so a leaf
-// whose key is at or above the last one is never behind a culled node. Hard cases: leaves flush with the node's faces, thin and flat leaves, rays
-// grazing a face, origins inside the dilation margin, tiny (1e-4) and huge (1e4) boxes, 3e6 offsets.
+// raised to it), which needs the exit side: no leaf interval ends after its ancestor's box exit, so a
+// leaf whose key is at or above the last one is never behind a culled node. Hard cases: leaves flush
+// with the node's faces, thin and flat leaves, rays grazing a face, origins inside the dilation margin,
+// tiny (1e-4) and huge (1e4) boxes, 3e6 offsets.
 #include <gtest/gtest.h>
 
 #include <cmath>
