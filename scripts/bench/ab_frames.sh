@@ -38,7 +38,9 @@ fi
 cp "$T"/train_*.log "$OUT"/
 row() { # NAME ARGS... (@M@ in ARGS: the binary's model folder)
   local name=$1; shift
-  "$NEW" render "${@//@M@/$T}" "${R[@]}" --spp 4 --out "$T/warm.png" > /dev/null 2>&1
+  # Warm-up at the measured spp (the same wave buffers); a machine's first renders can still run slow,
+  # which the spread check below reports.
+  "$NEW" render "${@//@M@/$T}" "${R[@]}" --spp "$SPP" --out "$T/warm.png" > /dev/null 2>&1
   for rep in 1 2; do
     for b in old new; do
       # shellcheck disable=SC2206
@@ -74,10 +76,16 @@ for name in ["default_classical", "default_hybrid", "dragon_classical", "dragon_
     r["flip_ldr_old_vs_new"] = float(m.group()) if m else None
     r["new_over_old"] = r["new"]["ms_per_spp"] / r["old"]["ms_per_spp"]
     rows[name] = r
+for k, r in rows.items():
+    # Spread of each binary's renders (slowest / fastest - 1): above 3 % one render was disturbed (a fresh
+    # machine's first renders have run 2-3x slow), so the row rests on the other render alone.
+    spread = {b: max(r[b]["all_ms_per_spp"]) / min(r[b]["all_ms_per_spp"]) - 1.0 for b in ("old", "new")}
+    r["spread"] = spread
+    flag = "  UNSTEADY (%s): rerun" % ", ".join("%s %.0f %%" % (b, 100 * v) for b, v in spread.items() if v > 0.03) \
+        if max(spread.values()) > 0.03 else ""
+    print("%-18s old %6.2f  new %6.2f ms/spp  new/old %.3f  FLIP old vs new %s%s" % (
+        k, r["old"]["ms_per_spp"], r["new"]["ms_per_spp"], r["new_over_old"], r["flip_ldr_old_vs_new"], flag))
 json.dump({"old": sys.argv[3], "new": sys.argv[4], "old_train_args": os.environ.get("OLD_TRAIN_ARGS"),
            "old_render_args": os.environ.get("OLD_RENDER_ARGS"),
            "train_args": os.environ.get("TRAIN_ARGS", ""), "rows": rows}, open(out, "w"), indent=1)
-for k, r in rows.items():
-    print("%-18s old %6.2f  new %6.2f ms/spp  new/old %.3f  FLIP old vs new %s" % (
-        k, r["old"]["ms_per_spp"], r["new"]["ms_per_spp"], r["new_over_old"], r["flip_ldr_old_vs_new"]))
 PY
