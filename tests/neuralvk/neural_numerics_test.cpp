@@ -70,9 +70,10 @@ void run_cases(const test::TestModel& tm, const std::vector<Case>& cases) {
         EXPECT_NEAR(h.t, t_ref, 2e-3f * len) << name;
         // A reversed query never accepts a hit behind (or at) the origin: no self-hit of a secondary
         // ray leaving a neural surface inside this leaf.
-        if (nb_query_reversed(qs[i].t_entry) && (h.flags & NB_NEURAL_ACCEPTED))
+        if (nb_query_reversed(qs[i].t_entry) && (h.flags & NB_NEURAL_ACCEPTED)) {
             EXPECT_GT(h.t, NB_DEPTH_EPSILON * (qs[i].t_exit - qs[i].t_entry)) << name;
-        if (qs[i].t_exit < 0.0f) EXPECT_FALSE(h.flags & NB_NEURAL_ACCEPTED) << name;
+        }
+        if (qs[i].t_exit < 0.0f) { EXPECT_FALSE(h.flags & NB_NEURAL_ACCEPTED) << name; }
     }
     EXPECT_EQ(ctx.validation_message_count(), 0);
 }

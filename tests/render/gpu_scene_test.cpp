@@ -30,7 +30,7 @@ TEST(GpuScene, PacksQuadWithInstancesInTlasOrder) {
     // Every interior reference points inside the BLAS array.
     for (const GpuWideNode& n : d.blas_nodes)
         for (uint32_t ref : {n.child0, n.child1, n.child2, n.child3})
-            if (!nb_is_leaf(ref) && ref != NB_CHILD_NONE) EXPECT_LT(ref, d.blas_nodes.size());
+            if (!nb_is_leaf(ref) && ref != NB_CHILD_NONE) { EXPECT_LT(ref, d.blas_nodes.size()); }
     // The quad's two triangles are one leaf: its BLAS root is a 4-wide node with that one child.
     ASSERT_EQ(d.blas_nodes.size(), 1u);
     EXPECT_EQ(d.blas_nodes[0].child0, nb_make_leaf(0, 2));

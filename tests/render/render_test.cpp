@@ -159,7 +159,7 @@ TEST(Render, SortedRaysKeepTheImage) {
         expect_sane(plain);
         expect_sane(sorted);
         EXPECT_FALSE(ran_pass(plain, "passes/ray_sort.comp"));
-        if (!sorted.result.stats.pass_ms.empty()) EXPECT_TRUE(ran_pass(sorted, "passes/ray_sort.comp"));
+        if (!sorted.result.stats.pass_ms.empty()) { EXPECT_TRUE(ran_pass(sorted, "passes/ray_sort.comp")); }
         EXPECT_GT(sorted.result.stats.rays_secondary, 0u);
         EXPECT_GT(sorted.result.stats.rays_shadow, 0u);
         EXPECT_EQ(plain.result.stats.rays_secondary, sorted.result.stats.rays_secondary);
@@ -255,7 +255,7 @@ TEST(Render, PassTimesAndRaysByPathDepthAddUpToTheTotals) {
     for (uint32_t d = 0; d < max_depth; ++d) {
         path += st.rays_by_depth[d];
         shadow += st.shadow_rays_by_depth[d];
-        if (d > 0) EXPECT_LE(st.rays_by_depth[d], st.rays_by_depth[d - 1]) << "a bounce continues at most its rays";
+        if (d > 0) { EXPECT_LE(st.rays_by_depth[d], st.rays_by_depth[d - 1]) << "a bounce continues at most its rays"; }
     }
     EXPECT_EQ(path, st.rays_primary + st.rays_secondary);
     EXPECT_EQ(shadow, st.rays_shadow);
@@ -283,9 +283,10 @@ TEST(Render, PassTimesAndRaysByPathDepthAddUpToTheTotals) {
             sum += d;
         }
         EXPECT_NEAR(sum, ms, 1e-9 * std::max(1.0, ms)) << name;
-        if (name == "passes/camera_rays.comp") EXPECT_EQ(by_depth.size(), 1u);
-        if (name == "passes/traverse.comp" || name == "passes/shade.comp")
+        if (name == "passes/camera_rays.comp") { EXPECT_EQ(by_depth.size(), 1u); }
+        if (name == "passes/traverse.comp" || name == "passes/shade.comp") {
             EXPECT_EQ(by_depth.size(), size_t(max_depth)) << name << ": every bounce traces";
+        }
     }
 }
 

@@ -67,7 +67,7 @@ void compare_with_cpu(const Scene& scene, size_t ray_count, double min_agreement
         const bool same_prim = cpu.instance == gpu[i].instance && cpu.triangle == gpu[i].triangle;
         if (std::abs(cpu.t - gpu[i].t) <= 1e-5f * scale && (same_prim || std::abs(cpu.t - gpu[i].t) <= 1e-6f * scale))
             ++agree;
-        if (same_prim) EXPECT_NEAR(cpu.t, gpu[i].t, 1e-5f * scale) << "ray " << i;
+        if (same_prim) { EXPECT_NEAR(cpu.t, gpu[i].t, 1e-5f * scale) << "ray " << i; }
     }
     EXPECT_GT(double(hits), min_hits * double(ray_count)) << "the test rays should mostly hit";
     EXPECT_GE(double(agree), min_agreement * double(ray_count)) << agree << " of " << ray_count << " agree";
