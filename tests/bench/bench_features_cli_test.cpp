@@ -66,7 +66,7 @@ TEST(BenchFeatures, OwnAndForcedOnLavapipe) {
             const bool used = f["in_scene"].get<bool>();
             EXPECT_EQ(used, s["features"].get<std::string>().find(FORCIBLE[i]) != std::string::npos) << FORCIBLE[i];
             EXPECT_EQ(f.contains("forced_ms"), !used) << FORCIBLE[i] << ": timed alone only where the scene lacks it";
-            if (!used) EXPECT_EQ(f["pixels_differing"].get<double>(), 0.0) << FORCIBLE[i];
+            if (!used) { EXPECT_EQ(f["pixels_differing"].get<double>(), 0.0) << FORCIBLE[i]; }
         }
     }
     // The default scene: textures, emission, sky and single-sided materials; the bunny: the sky only.

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "engine/core/error.h"
+#include "engine/core/log.h"
 #include "engine/neural/fp16.h"
 #include "engine/neural/losses.h"
 #include "engine/neural/reference_network.h"
@@ -89,7 +90,7 @@ TEST(Gradients, EveryMlpLayerMatchesFiniteDifferences) {
                 s.w.mlp[i] = w0 - h;
                 const double lm = linear_loss(s.w, s.q, s.c);
                 s.w.mlp[i] = w0;
-                expect_close(s.g.mlp[i], (lp - lm) / (2 * h), "W" + std::to_string(m) + " weight " + std::to_string(i));
+                expect_close(s.g.mlp[i], (lp - lm) / (2 * h), strfmt("W%u weight %zu", unsigned(m), size_t(i)));
                 nonzero += s.g.mlp[i] != 0.0;
             }
             EXPECT_GE(nonzero, 20) << "layer " << m << " gradients are mostly zero: the check would be vacuous";

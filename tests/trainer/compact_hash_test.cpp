@@ -26,8 +26,8 @@ TEST(CompactHash, GridIsAtMostAFifthOfTheGeometry) {
         const uint32_t t = compact_hash_log2(cfg, geo, 18);
         EXPECT_GE(t, COMPACT_HASH_MIN_LOG2);
         EXPECT_LE(t, 18u);
-        if (t > COMPACT_HASH_MIN_LOG2) EXPECT_LE(grid_bytes(cfg, t) * COMPACT_HASH_RATIO, geo) << tris;
-        if (t < 18u) EXPECT_GT(grid_bytes(cfg, t + 1) * COMPACT_HASH_RATIO, geo) << tris;
+        if (t > COMPACT_HASH_MIN_LOG2) { EXPECT_LE(grid_bytes(cfg, t) * COMPACT_HASH_RATIO, geo) << tris; }
+        if (t < 18u) { EXPECT_GT(grid_bytes(cfg, t + 1) * COMPACT_HASH_RATIO, geo) << tris; }
     }
     EXPECT_EQ(compact_hash_log2(cfg, 10, 8), 8u);
 }

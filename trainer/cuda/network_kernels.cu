@@ -202,7 +202,7 @@ using FragCh = wmma::fragment<wmma::accumulator, 16, 16, 16, __half>;
 // ReLU, the fp16 rounding and the ReLU mask are applied on the accumulator fragments in registers: element
 // i of an fp32 and of an fp16 accumulator fragment is the same matrix element (both are the m16n8k16 C
 // layout on sm_70+), which the CPU cross-check of every activation and gradient (tests/cuda) verifies.
-static_assert(FragC::num_elements == FragCh::num_elements, "accumulator fragments must match");
+static_assert(int(FragC::num_elements) == int(FragCh::num_elements), "accumulator fragments must match");
 
 // H(16 x 64) = fp16(relu(X(16 x 16*KT) W_m^T)) for one warp (rounding point R3 of mlp.h), stored as fp16.
 // The A fragments of the warp's rows are loaded once and reused for the 4 output column tiles.
