@@ -38,8 +38,9 @@ fi
 cp "$T"/train_*.log "$OUT"/
 row() { # NAME ARGS... (@M@ in ARGS: the binary's model folder)
   local name=$1; shift
-  # Warm-up at the measured spp (the same wave buffers); a machine's first renders can still run slow,
-  # which the spread check below reports.
+  # Warm-up of both binaries at the measured spp (the same wave buffers); a machine's first renders can
+  # still run slow, which the spread check below reports.
+  "$OLD" render "${@//@M@/$OLDM}" "${R[@]}" --spp "$SPP" --out "$T/warm.png" > /dev/null 2>&1
   "$NEW" render "${@//@M@/$T}" "${R[@]}" --spp "$SPP" --out "$T/warm.png" > /dev/null 2>&1
   for rep in 1 2; do
     for b in old new; do

@@ -20,7 +20,9 @@ done
 R=(--width 1920 --height 1080 --spp 16)
 for scene in default dragon; do
   if [ $scene = default ]; then S=(default); C=(--classical); else S=($T/dragon.glb); C=(--neural '*' --classical); fi
-  $B render "${S[@]}" --model $T/$scene.nbvh "${R[@]}" --out $T/warm.png >/dev/null 2>&1 # warm-up at the measured spp
+  # Warm-up of both sides at the measured spp.
+  $B render "${S[@]}" "${C[@]}" "${R[@]}" --out $T/warm.png >/dev/null 2>&1
+  $B render "${S[@]}" --model $T/$scene.nbvh "${R[@]}" --out $T/warm.png >/dev/null 2>&1
   for rep in 1 2 3; do
     $B render "${S[@]}" "${C[@]}" "${R[@]}" --out $T/${scene}_c.png --stats $OUT/${scene}_classical_$rep.json > $T/log 2>&1 || { echo "FAIL $scene classical"; tail -2 $T/log; }
     $B render "${S[@]}" --model $T/$scene.nbvh "${R[@]}" --out $T/${scene}_h.png --stats $OUT/${scene}_hybrid_$rep.json > $T/log 2>&1 || { echo "FAIL $scene hybrid"; tail -2 $T/log; }
