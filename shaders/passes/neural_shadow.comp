@@ -52,9 +52,8 @@ void main() {
     g_alpha_seed = nb_shadow_alpha_seed(shadow_load1(NB_SHADOW_PIXEL, i) & ~NB_RAY_BACKFACE_BIT);
     nb_nl_begin(st, neural_params.lod_secondary, nb_nl_want(st));
     // Triangles first: a ray they occlude walks no N-BVH (in one walk, an N-BVH the TLAS reaches before
-    // the occluding triangles was walked for nothing). Then the neural instances alone. H200, 1080p 16
-    // spp: neural shadow rays 1.07 -> 0.99 ms per sample (default scene), 0.30 -> 0.26 (dragon); the
-    // same split for path rays measured slower on the default scene (traversal 1.89 -> 2.00).
+    // the occluding triangles was walked for nothing). Then the neural instances alone. Measured, and
+    // why path rays keep one walk: engine/render/NEURAL.md.
     if (op == 0u) {
         g_nl_skip_triangles = false;
         g_nl_skip_neural = true;
