@@ -142,7 +142,6 @@ void run_bench(const BenchArgs& a) {
                         {"height", options.height}, {"spp", options.spp}, {"max_depth", options.max_depth},
                         {"repeat", a.repeat}, {"neural_path", path_name},
                         {"sampler", render::sampler_name(options.sampler)},
-                        {"light_samples", options.light_samples},
                         {"flip_metric", "ldr: ACES tone map + 8-bit sRGB (as nbvh render PNGs), ppd 67.02; hybrid and "
                                         "reference share the seed"},
                         {"classical",

@@ -193,7 +193,6 @@ void run_converge(const ConvergeArgs& a) {
         {"secondary_lod", a.secondary_lod},
         {"neural_path", neural_path},
         {"sampler", render::sampler_name(base.sampler)},
-        {"light_samples", base.light_samples},
         {"seed", base.seed},
         {"reference_seed", ref_opt.seed},
         {"ref_spp", ref_spp},

@@ -62,7 +62,6 @@ nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o
                         {"rr_start_depth", o.rr_start_depth},
                         {"sort_rays", o.sort_rays},
                         {"sampler", render::sampler_name(o.sampler)},
-                        {"light_samples", o.light_samples},
                         {"max_wave_pixels", o.max_wave_pixels},
                         {"texture_path", a.texture_path}};
     if (o.neural.model) {

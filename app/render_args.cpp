@@ -72,10 +72,6 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
            "or in queue order (off); same image")
         ->check(CLI::IsMember({"on", "off"}));
     add_sampler_flag(cmd, o.sampler);
-    cmd->add_option("--light-samples", o.light_samples,
-                    "next-event (light) samples at each camera ray's hit, each with its own shadow ray: less "
-                    "direct-light noise per sample, same expected image (default 1; deeper hits take one)")
-        ->check(CLI::Range(1u, 64u));
     cmd->add_option("--wave-pixels", o.max_wave_pixels,
                     "paths traced per wave (rays per queue; several samples of each pixel while they fit in 32M paths, "
                     "up to 16; also bounded by the device's buffer, memory and dispatch limits)")

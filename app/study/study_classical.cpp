@@ -60,7 +60,6 @@ double StudyRun::time_frame(WavefrontRenderer& image_renderer, WavefrontRenderer
     WavefrontRenderer& r = timing_renderer ? *timing_renderer : image_renderer;
     opt.spp = o_.time_spp;
     opt.seed = o_.render.seed;
-    opt.light_samples = 1; // timing_options()
     if (timing_renderer) opt.width = time_width_, opt.height = time_height_;
     NBVH_CHECK(r.apply(opt));
     return median_render_stats(r, o_.repeat).gpu_ms;

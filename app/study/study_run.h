@@ -60,11 +60,8 @@ class StudyRun {
         r.neural.path = neural_path_;
         return r;
     }
-    // Timed frames: what `nbvh render` does by default, one light sample (--light-samples is for the
-    // compared images: less noise for the FLIPs, the same expected image).
     RenderOptions timing_options() const {
         RenderOptions r = image_options(o_.time_spp, o_.render.seed);
-        r.light_samples = 1;
         if (time_width_) r.width = time_width_, r.height = time_height_;
         return r;
     }

@@ -124,8 +124,6 @@ void StudyRun::write_results() const {
           {"leaves_per_round", o_.render.neural.leaves_per_round},
           {"neural_path", render::neural_path_name(neural_path_)},
           {"sampler", render::sampler_name(o_.render.sampler)},
-          {"light_samples", o_.render.light_samples},
-          {"time_light_samples", t.light_samples},
           {"neural_kernel", kernel_},
           {"lods", o_.lods},
           {"exposure", o_.exposure},

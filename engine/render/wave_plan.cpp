@@ -27,10 +27,9 @@ uint64_t wave_bytes_per_path(const RenderOptions& o) {
 }
 
 uint64_t counter_safe_paths(const RenderOptions& o) {
-    // Rays (path or shadow) grow by at most 2 per path and bounce, shadow rays by light_samples - 1 more
-    // at the camera rays' hits; the query counter, which grows with the leaf budget, is 64-bit
-    // (GpuNeuralCounters).
-    const uint64_t per_path = 2ull * std::max(o.max_depth, 1u) + std::max(o.light_samples, 1u) - 1u;
+    // Rays (path or shadow) grow by at most 2 per path and bounce; the query counter, which grows with
+    // the leaf budget, is 64-bit (GpuNeuralCounters).
+    const uint64_t per_path = 2ull * std::max(o.max_depth, 1u);
     return std::max<uint64_t>((1ull << 31) / per_path, 64);
 }
 

@@ -48,10 +48,6 @@ void set_camera_params(GpuFrameParams& p, const Camera& camera, float aspect) {
 
 uint32_t gpu_sampler(Sampler s) { return s == Sampler::sobol ? NB_SAMPLER_SOBOL : NB_SAMPLER_RANDOM; }
 
-void check_light_samples(uint32_t n) {
-    if (n == 0 || n > 64) throw Error(strfmt("--light-samples must be in 1..64 (got %u)", n));
-}
-
 } // namespace
 
 WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene, const SceneAccel& accel,
@@ -62,7 +58,6 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
         throw Error(strfmt("image size %ux%u is out of range (1..16384 per side)", options_.width, options_.height));
     if (options_.spp == 0) throw Error("--spp must be at least 1");
     if (options_.max_depth == 0 || options_.max_depth > 256) throw Error("--max-depth must be in 1..256");
-    check_light_samples(options_.light_samples);
     const vk::DeviceFeatures& dev = ctx_.features();
     if (!dev.scalar_layout) throw Error("the Vulkan device lacks scalarBlockLayout, which every pass needs");
     const uint64_t pixels = uint64_t(options_.width) * options_.height;
@@ -130,7 +125,6 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     p.instance_count = accel.tlas.prim_indices.empty() ? 0u : uint32_t(data_.instances.size());
     p.sort_rays = options_.sort_rays ? 1u : 0u;
     p.path_sampler = gpu_sampler(options_.sampler);
-    p.light_samples = options_.light_samples;
 
     // Buffers, indexed by binding.
     buffers_.resize(NB_BINDING_COUNT);
@@ -250,9 +244,7 @@ void WavefrontRenderer::make_timer() {
                                                                std::max<uint64_t>(pixels, 1),
                                                            wave_samples_, MAX_SAMPLES_PER_SUBMISSION));
     const uint32_t waves = (samples_per_submission_ + wave_samples_ - 1) / wave_samples_;
-    const uint32_t rounds = neural_ ? 3 * neural_->batched_rounds() + 4 : 0; // one neural walk's passes
-    const uint32_t per_wave = 2 + (8 + 2 * rounds) * options_.max_depth +
-                              (options_.light_samples - 1) * (5 + rounds); // the extra light samples
+    const uint32_t per_wave = 2 + (8 + (neural_ ? 6 * neural_->batched_rounds() + 8 : 0)) * options_.max_depth;
     timer_ = vk::GpuTimer(ctx_, 62 + per_wave * waves);
 }
 
@@ -271,7 +263,6 @@ bool WavefrontRenderer::apply(const RenderOptions& o) {
         (n.classical && overrides) != classical_overrides_ || (n.model && !features_.neural && !n.classical) ||
         !(o.forced_features == c.forced_features) || capacity_ > counter_safe_paths(o))
         return false;
-    check_light_samples(o.light_samples);
     if (n.model) validate(n, *scene_);
     if (swap) swap_model(n);
     ++live_updates_;
@@ -287,8 +278,6 @@ bool WavefrontRenderer::apply(const RenderOptions& o) {
     params_.sort_rays = o.sort_rays ? 1u : 0u;
     options_.sampler = o.sampler;
     params_.path_sampler = gpu_sampler(o.sampler);
-    options_.light_samples = o.light_samples;
-    params_.light_samples = o.light_samples;
     buffers_[NB_BIND_PARAMS].upload(&params_, sizeof(params_));
     if (neural_) {
         options_.neural = n;
@@ -368,16 +357,6 @@ bool WavefrontRenderer::record_ray_sort(vk::CommandBuffer& cmd, uint32_t q, uint
     return true;
 }
 
-// The shadow rays the shade pass queued: their arguments, then visibility and light.
-void WavefrontRenderer::record_shadow_rays(vk::CommandBuffer& cmd, uint32_t q, uint32_t depth, const Wave& w) {
-    record_pass(cmd, QUEUE_ARGS, constants(q, depth, w, NB_ARGS_MODE_SHADOW), Dispatch::single);
-    // Hybrid: neural_shadow's op 0 reads the order and decides; shadow.comp only applies it.
-    const bool sort = !hybrid_ && record_ray_sort(cmd, q, depth, w, true);
-    if (hybrid_) record_neural_rounds(cmd, NEURAL_SHADOW, q, depth, w);
-    record_pass(cmd, SHADOW, constants(q, depth, w, hybrid_ ? NB_SHADOW_MODE_HYBRID : (sort ? NB_SHADOW_MODE_SORTED : 0u)),
-                Dispatch::indirect_shadow);
-}
-
 void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, const Wave& w) {
     record_pass(cmd, CAMERA, constants(0, 0, w, 0), Dispatch::items, uint64_t(w.count) * w.samples);
     uint32_t q = 0;
@@ -392,15 +371,14 @@ void WavefrontRenderer::record_sample_wave(vk::CommandBuffer& cmd, const Wave& w
         }
         record_pass(cmd, SHADE, constants(q, depth, w, 0), Dispatch::indirect_rays);
         if (features_.has_lights()) {
-            record_shadow_rays(cmd, q, depth, w);
-            // The camera rays' hits' other light samples (shade.comp: NEE only, one shadow ray per path
-            // in the queue at a time; the hits and the continuation rays stay).
-            const uint32_t light_samples = depth == 0 && options_.max_depth > 1 ? options_.light_samples : 1;
-            for (uint32_t j = 1; j < light_samples; ++j) {
-                record_pass(cmd, QUEUE_ARGS, constants(q, depth, w, NB_ARGS_MODE_LIGHT), Dispatch::single);
-                record_pass(cmd, SHADE, constants(q, depth, w, j), Dispatch::indirect_rays);
-                record_shadow_rays(cmd, q, depth, w);
-            }
+            record_pass(cmd, QUEUE_ARGS, constants(q, depth, w, NB_ARGS_MODE_SHADOW),
+                        Dispatch::single);
+            // Hybrid: neural_shadow's op 0 reads the order and decides; shadow.comp only applies it.
+            const bool sort = !hybrid_ && record_ray_sort(cmd, q, depth, w, true);
+            if (hybrid_) record_neural_rounds(cmd, NEURAL_SHADOW, q, depth, w);
+            record_pass(cmd, SHADOW,
+                        constants(q, depth, w, hybrid_ ? NB_SHADOW_MODE_HYBRID : (sort ? NB_SHADOW_MODE_SORTED : 0u)),
+                        Dispatch::indirect_shadow);
         }
         q = 1 - q;
     }

@@ -36,9 +36,6 @@ struct RenderOptions {
     uint32_t max_depth = 8;          // path segments (1: emitters and environment seen directly)
     uint32_t seed = 0;
     uint32_t rr_start_depth = 3;     // Russian roulette from this segment on
-    // Next-event samples at each camera ray's hit (1..64; deeper hits take one): less noise from the
-    // direct light for n - 1 more shadow rays per path (same expected image). --light-samples.
-    uint32_t light_samples = 1;
     // Paths per wave (rays per queue), further bounded by the device (one buffer's bytes, a quarter of
     // its memory, the dispatch limits) and the statistics counters; a wave of several samples of every
     // pixel holds at most 32M paths (engine/render/wave_plan.h). 32M: sixteen samples of a 1080p frame,
@@ -173,7 +170,6 @@ private:
     // Records passes/ray_sort.comp for the path queue q (not camera rays) or the shadow queue when the
     // ray order is on; returns whether the traversal that follows reads the order.
     bool record_ray_sort(vk::CommandBuffer& cmd, uint32_t q, uint32_t depth, const Wave& w, bool shadow);
-    void record_shadow_rays(vk::CommandBuffer& cmd, uint32_t q, uint32_t depth, const Wave& w);
     // Samples [first, first + count) into the film (cleared when first == 0), then resolve + read back.
     RenderResult render_samples(uint32_t first, uint32_t count, bool read_back = true);
 

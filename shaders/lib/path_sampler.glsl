@@ -52,17 +52,6 @@ vec2 nb_path_2d(inout PathSampler ps, uint pair) {
     return vec2(u1, u2);
 }
 
-// The numbers of light sample j of n at a path vertex (--light-samples: n > 1 at the camera rays' hits,
-// shade.comp). Under --sampler sobol each light pair is one net of n points per pixel sample (sample s takes
-// points s * n .. s * n + n - 1 of the pair's Owen-scrambled sequence: stratified over all spp * n); under
-// --sampler random light sample 0 draws from the path's stream as with one sample (the caller carries
-// the advanced stream on), the others from streams of their own. n == 1: the path's own sampler.
-PathSampler nb_light_sampler(PathSampler ps, uint j, uint n) {
-    if (n > 1u) ps.sample_index = ps.sample_index * n + j;
-    if (j > 0u) ps.rng = nb_pcg_hash(ps.rng ^ (j * 0x9E3779B9u));
-    return ps;
-}
-
 // One random bit for a decision only some renders of a seed make (a neural hit's material spread):
 // under --sampler random it must not advance the PCG stream, so that a hybrid render and its classical
 // reference of the same seed keep sharing their numbers (nbvh bench's shared-seed FLIP); a Sobol pair

@@ -1,8 +1,7 @@
 // Turns a queue's atomic counter into vkCmdDispatchIndirect arguments (invocation 0). Mode rays:
 // arguments for path-ray queue pc.in_queue; empties the other queue (the shade pass appends to it) and
 // the shadow queue; counts the rays for --stats (also per bounce). Mode shadow: arguments for the shadow
-// queue. Mode light: empties the shadow queue (and its bins) for another light sample of the camera
-// rays' hits (--light-samples; the path queues and their arguments stay). With the ray order (params.sort_rays, shared/wavefront_gpu.h NB_RS_*) the whole workgroup also
+// queue. With the ray order (params.sort_rays, shared/wavefront_gpu.h NB_RS_*) the whole workgroup also
 // turns the queue's bin counts into offsets for passes/ray_sort.comp (exclusive scan; camera rays at
 // depth 0 are not sorted) and, in mode rays, zeroes the bins the next shade pass counts into (the other
 // queue's and the shadow queue's, whose offsets served the previous bounce).
@@ -61,8 +60,6 @@ void main() {
             if (pc.depth == 0u) counters.rays_primary += n;
             else counters.rays_secondary += n;
             counters.rays_by_depth[min(pc.depth, NB_STAT_DEPTHS - 1u)] += n;
-        } else if (pc.mode == NB_ARGS_MODE_LIGHT) {
-            counters.shadow_count = 0u;
         } else {
             uint n = counters.shadow_count;
             counters.shadow_dispatch.x = groups(n);
@@ -73,9 +70,11 @@ void main() {
         }
     }
     // Zeroed with the order off too, so that switching it on between renders finds no stale offsets.
-    if (pc.mode == NB_ARGS_MODE_RAYS) zero_bins(NB_RS_PATH_BINS(1u - pc.in_queue));
-    if (pc.mode != NB_ARGS_MODE_SHADOW) zero_bins(NB_RS_SHADOW_BINS);
-    if (params.sort_rays == 0u || pc.mode == NB_ARGS_MODE_LIGHT) return; // uniform
+    if (pc.mode == NB_ARGS_MODE_RAYS) {
+        zero_bins(NB_RS_PATH_BINS(1u - pc.in_queue));
+        zero_bins(NB_RS_SHADOW_BINS);
+    }
+    if (params.sort_rays == 0u) return; // uniform
     if (pc.mode == NB_ARGS_MODE_RAYS) {
         if (pc.depth > 0u) scan_bins(NB_RS_PATH_BINS(pc.in_queue));
     } else {

@@ -5,12 +5,6 @@
 //            lib/lights.glsl nb_light_strategies), evaluated here and appended to the shadow queue with its
 //            MIS weight (power heuristic; punctual lights are delta lights: weight 1, NEE only);
 //            BSDF sampling + Russian roulette: the continuation ray is appended to queue 1 - in_queue.
-// --light-samples n > 1: the camera rays' hits take n light samples, each weighted 1/n, with the
-// multi-sample power heuristic (Veach 1997, 9.2.4: the light strategy counts n times, so the light pdf
-// enters as n * pdf and the continuation carries its BSDF pdf / n, which the next hit's MIS weighs
-// against n * pdf: the heuristic is scale-invariant); sample 0 here, sample j = pc.mode in a later run
-// of this pass (NEE only, after the shadow rays of sample j - 1 were traced: engine/render/wavefront.cpp):
-// at most one shadow ray per path in the queue, whatever n.
 // Radiance goes to sample_radiance[slot] (the path's slot in the wave, NB_RAY_PIXEL: no races).
 #version 460
 #include "lib/bindings.glsl"
@@ -39,12 +33,9 @@ void main() {
     float p_env, p_emissive, p_punctual;
     nb_light_strategies(p_env, p_emissive, p_punctual);
 
-    uint light_sample = pc.mode; // > 0: NEE only, for that light sample of a camera ray's hit
-    uint light_n = depth == 0u ? params.light_samples : 1u;
-
     uint instance = hit_load1(NB_HIT_INSTANCE, i);
     if (instance == NB_NO_HIT) {
-        if (NB_HAS_ENVIRONMENT && light_sample == 0u) {
+        if (NB_HAS_ENVIRONMENT) {
             float w = 1.0f;
             if (prev_pdf > 0.0f) w = nb_power_heuristic(prev_pdf, p_env * nb_env_pdf(dir));
             sample_radiance[slot] += throughput * nb_env_radiance(dir) * w;
@@ -58,7 +49,7 @@ void main() {
                     : nb_make_surface(instance, tri_index, hit_load_bary(i), org, dir, t);
     vec3 wo = -dir;
 
-    if (NB_HAS_EMISSION && light_sample == 0u && dot(s.emission, s.emission) > 0.0f) {
+    if (NB_HAS_EMISSION && dot(s.emission, s.emission) > 0.0f) {
         float w = 1.0f;
         if (prev_pdf > 0.0f && params.light_count > 0u) {
             float cos_l = abs(dot(s.ng, dir));
@@ -78,10 +69,8 @@ void main() {
         vec3 le = vec3(0.0f);
         bool delta = false; // punctual: light_pdf is a discrete probability, no MIS
         // Which light within the strategy: only scenes with emitters or punctual lights draw it.
-        PathSampler lps = nb_light_sampler(ps, light_sample, light_n);
-        vec2 pick = (NB_HAS_EMISSION || NB_HAS_PUNCTUAL) ? nb_path_2d(lps, NB_PAIR_LIGHT_PICK) : vec2(0.0f);
-        vec2 ul = nb_path_2d(lps, NB_PAIR_LIGHT);
-        ps.rng = lps.rng; // --sampler random: the stream goes on from the light sample's draws
+        vec2 pick = (NB_HAS_EMISSION || NB_HAS_PUNCTUAL) ? nb_path_2d(ps, NB_PAIR_LIGHT_PICK) : vec2(0.0f);
+        vec2 ul = nb_path_2d(ps, NB_PAIR_LIGHT);
         // The strategy comes from the light sample's own first coordinate, rescaled to [0, 1) for the
         // chosen strategy (nb_sample_reuse): under --sampler sobol the samples of each strategy stay
         // a stratified 2D net instead of a random subset of one (default scene, 240x135, 64 spp, two
@@ -100,7 +89,6 @@ void main() {
             light_pdf *= p_punctual;
             delta = true;
         }
-        light_pdf *= float(light_n); // n samples of the light strategy (1/n each; MIS: above)
         if (light_pdf > 0.0f && dot(le, le) > 0.0f) {
             float bsdf_pdf;
             vec3 f = nb_bsdf_eval(s, wo, wi, bsdf_pdf);
@@ -121,8 +109,6 @@ void main() {
         }
     }
 
-    if (light_sample > 0u) return;
-
     // Continuation.
     vec3 wi, weight;
     float pdf;
@@ -137,7 +123,6 @@ void main() {
     if (!(max(throughput.x, max(throughput.y, throughput.z)) > 0.0f)) return;
     // Without anything to sample by NEE, emitters hit by BSDF sampling take the full weight.
     if (!(NB_HAS_ENVIRONMENT || NB_HAS_EMISSION)) pdf = -1.0f;
-    else pdf /= float(light_n); // the next hit's MIS against n light samples (above)
     uint out_q = 1u - q;
     uint k = out_q == 0u ? atomicAdd(counters.ray_count0, 1u) : atomicAdd(counters.ray_count1, 1u);
     vec3 n_side = dot(wi, s.ng) >= 0.0f ? s.ng : -s.ng; // transmission leaves through the back

@@ -175,7 +175,7 @@ struct GpuFrameParams {
                            // their power cdf follows the emissive one in light_cdf (at light_count + 1)
     uint sort_rays;        // 1: shade.comp counts the rays it appends into the ray-sort bins (NB_RS_*)
     uint path_sampler;     // NB_SAMPLER_*: the path's random numbers (lib/path_sampler.glsl)
-    uint light_samples;    // next-event samples at each camera ray's hit (--light-samples; deeper hits: 1)
+    uint pad0;
     uint pad1;
     uint pad2;
 };

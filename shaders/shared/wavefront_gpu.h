@@ -153,7 +153,6 @@ NB_FN uint nb_rs_key(vec3 o, vec3 d, vec3 lo, vec3 hi) {
 // ---- Push constants (<= 128 bytes, the Vulkan minimum) --------------------------------------------
 #define NB_ARGS_MODE_RAYS 0u    // queue_args.comp: arguments for path-ray queue `in_queue`
 #define NB_ARGS_MODE_SHADOW 1u  // queue_args.comp: arguments for the shadow queue
-#define NB_ARGS_MODE_LIGHT 2u   // queue_args.comp: empties the shadow queue for another light sample
 
 struct GpuPassConstants {
     uint in_queue;      // path-ray queue read by this pass (0 or 1)
@@ -161,7 +160,7 @@ struct GpuPassConstants {
     uint sample_index;  // sample of the pixel (0 .. spp-1)
     uint pixel_offset;  // first pixel of the current wave
     uint pixel_count;   // pixels in the current wave
-    uint mode;          // pass-specific (NB_ARGS_MODE_*, NB_SHADOW_MODE_*; shade.comp: the light sample)
+    uint mode;          // pass-specific (NB_ARGS_MODE_*, NB_SHADOW_MODE_*)
     uint wave_samples;  // samples per pixel in the current wave (sample_index .. + wave_samples - 1)
 };
 NB_STATIC_ASSERT(sizeof(GpuPassConstants) == 28, "GpuPassConstants layout");

@@ -331,39 +331,3 @@ TEST(HybridRender, BackfaceEscapeLeavesTheAsset) {
     EXPECT_LT(flip_on, flip_off + 0.005f);
     EXPECT_NE(on.image.data, off.image.data);
 }
-
-// --light-samples n in a hybrid render: the camera rays' other light samples are traced through the
-// neural shadow rounds one shadow queue at a time, while the path rays' neural hits (their predicted
-// normal and albedo) wait for shade.comp's next light-sample run. Same expected image as one light sample
-// (a light sample shaded at a stale or another ray's hit would move the mean), n times the depth-0
-// shadow rays per sample, no validation message.
-TEST(HybridRender, LightSamplesKeepTheExpectedImage) {
-    NBVH_REQUIRE_SHARED();
-    const Fixture& f = trained_bunny();
-    auto with = [](uint32_t spp, uint32_t light_samples, uint32_t seed) {
-        return [=](RenderOptions& o) {
-            o.width = o.height = 32;
-            o.spp = spp;
-            o.light_samples = light_samples;
-            o.seed = seed;
-        };
-    };
-    const Rendered one = render_bunny(f, true, with(256, 1, 3));
-    const Rendered four = render_bunny(f, true, with(64, 4, 4));
-    EXPECT_EQ(one.validation + four.validation, 0);
-    EXPECT_EQ(one.stats.nonfinite_samples + four.stats.nonfinite_samples, 0u);
-    auto mean = [](const Image& img) {
-        double m = 0.0;
-        for (float v : img.data) m += v;
-        return m / double(img.data.size());
-    };
-    std::printf("hybrid 32x32, depth 3: 1 light sample x 256 spp mean %.5f, 4 x 64 spp %.5f\n", mean(one.image),
-                mean(four.image));
-    EXPECT_NEAR(mean(four.image) / mean(one.image), 1.0, 0.02);
-    ASSERT_GE(one.stats.shadow_rays_by_depth.size(), 2u);
-    ASSERT_GE(four.stats.shadow_rays_by_depth.size(), 2u);
-    // 256 light samples per pixel at the first hit in both; deeper hits: one per sample (4x fewer).
-    EXPECT_NEAR(double(four.stats.shadow_rays_by_depth[0]) / double(one.stats.shadow_rays_by_depth[0]), 1.0, 0.05);
-    EXPECT_NEAR(double(four.stats.shadow_rays_by_depth[1]) / double(one.stats.shadow_rays_by_depth[1]), 0.25, 0.05);
-    EXPECT_GT(four.stats.neural_queries, 0u);
-}

@@ -463,7 +463,6 @@ TEST(MultiAsset, SettingsApplyWithoutRebuildMatchFreshRenderers) {
     deeper.neural.roughness = 0.2f;
     deeper.neural.max_rounds = 3;
     deeper.sampler = render::Sampler::random; // the sampler is an upload too
-    deeper.light_samples = 3;                 // and the light samples (shade.comp's runs at depth 0)
 
     WavefrontRenderer live(ctx, scene, accel, default_sky(), scene.camera, classical);
     EXPECT_FALSE(live.hybrid());
