@@ -25,9 +25,11 @@ struct WavePlan {
     uint32_t samples = 1;  // samples of every pixel per wave (1 when the image takes several waves)
 };
 
-// Paths of a wave of several samples, whatever --wave-pixels says (its default too: 16 samples of 1080p).
+// Paths of a wave of several samples, whatever --wave-pixels says (its default too: 16 samples of 1080p),
+// and samples of every pixel per wave: 32 (16.6M paths at the study's 960x540; a renderer's queues are
+// bounded by a quarter of the GPU's memory, and `nbvh study` holds several renderers at once).
 constexpr uint64_t NB_WAVE_MAX_PATHS = 1u << 25;
-constexpr uint32_t NB_WAVE_MAX_SAMPLES = 16;
+constexpr uint32_t NB_WAVE_MAX_SAMPLES = 32;
 
 // Queue bytes per path: classical queues (two path-ray queues, hits, shadow rays, sample radiance),
 // and in a renderer with a model the neural state of a path and of its shadow ray and its pending

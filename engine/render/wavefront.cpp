@@ -242,7 +242,7 @@ void WavefrontRenderer::make_timer() {
         pixels > capacity_ ? 1u
                            : uint32_t(std::clamp<uint64_t>(std::min(PIXEL_SAMPLES_PER_SUBMISSION, counter_safe_paths(options_)) /
                                                                std::max<uint64_t>(pixels, 1),
-                                                           wave_samples_, MAX_SAMPLES_PER_SUBMISSION));
+                                                           wave_samples_, std::max(wave_samples_, MAX_SAMPLES_PER_SUBMISSION)));
     const uint32_t waves = (samples_per_submission_ + wave_samples_ - 1) / wave_samples_;
     const uint32_t per_wave = 2 + (8 + (neural_ ? 6 * neural_->batched_rounds() + 8 : 0)) * options_.max_depth;
     timer_ = vk::GpuTimer(ctx_, 62 + per_wave * waves);

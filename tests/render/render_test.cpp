@@ -115,17 +115,17 @@ TEST(Render, SameSeedSameImage) {
 
 // A small image traces several samples per wave (a path per slot: nb_slot_pixel / nb_slot_sample) and
 // accumulates each pixel's slots; the image must equal the one-sample-per-wave render of the same
-// random numbers (float summation order aside), with either sampler. 21 spp at 16 samples per wave: a
+// random numbers (float summation order aside), with either sampler. 37 spp at 32 samples per wave: a
 // full and a partial wave.
 TEST(Render, SamplesPerWaveKeepTheImage) {
     Scene s = test::make_quad_scene();
     const Environment env = constant_environment(glm::vec3(1.0f));
-    const uint32_t w = 24, h = 16, spp = 21;
+    const uint32_t w = 24, h = 16, spp = 37;
     for (Sampler sampler : {Sampler::sobol, Sampler::random}) {
         SCOPED_TRACE(sampler_name(sampler));
         const bool sort = RenderOptions{}.sort_rays;
         const Rendered one = render_small(s, env, spp, 3, 5, w, h, w * h, sort, sampler); // waves of the image
-        const Rendered many = render_small(s, env, spp, 3, 5, w, h, 1u << 22, sort, sampler); // 16 samples each
+        const Rendered many = render_small(s, env, spp, 3, 5, w, h, 1u << 22, sort, sampler); // 32 samples each
         expect_sane(one);
         expect_sane(many);
         EXPECT_EQ(one.result.stats.rays_primary, many.result.stats.rays_primary);

@@ -89,12 +89,12 @@ TEST(WavePlan, OneSamplePerCallKeepsOneSamplesQueues) {
     EXPECT_EQ(plan_wave(P1080, opts(3), h100()).samples, 3u);
 }
 
-TEST(WavePlan, SmallImagesStopAtSixteenSamples) {
+TEST(WavePlan, SmallImagesStopAtThirtyTwoSamples) {
     const WavePlan p = plan_wave(960ull * 540, opts(512), h100());
-    EXPECT_EQ(p.samples, 16u);
-    EXPECT_EQ(p.capacity, 16ull * 960 * 540);
-    const WavePlan one = plan_wave(1, opts(512), h100()); // one pixel: the 64-path floor, 16 samples
-    EXPECT_EQ(one.samples, 16u);
+    EXPECT_EQ(p.samples, 32u);
+    EXPECT_EQ(p.capacity, 32ull * 960 * 540);
+    const WavePlan one = plan_wave(1, opts(512), h100()); // one pixel: the 64-path floor, 32 samples
+    EXPECT_EQ(one.samples, 32u);
     EXPECT_GE(one.capacity, 64u);
 }
 

@@ -73,7 +73,7 @@ TEST(Progressive, OneSampleAtATimeEqualsOneRender) {
 
 // A film left by render() goes on with render_progressive: the samples after it are the one-shot render's
 // next ones (the study extends its floor render to the equal-time spp this way). 20 + 13 samples cross
-// the multi-sample waves (up to 16 samples of a small image per wave) unaligned.
+// the multi-sample waves (up to 32 samples of a small image per wave) unaligned.
 TEST(Progressive, RenderThenMoreSamplesEqualsOneLongerRender) {
     const Fixture& f = fixture();
     vk::Context ctx = make_context();
