@@ -60,7 +60,10 @@ double StudyRun::time_frame(WavefrontRenderer& image_renderer, WavefrontRenderer
     WavefrontRenderer& r = timing_renderer ? *timing_renderer : image_renderer;
     opt.spp = o_.time_spp;
     opt.seed = o_.render.seed;
-    if (timing_renderer) opt.width = time_width_, opt.height = time_height_;
+    if (timing_renderer) { // built with timing_options()
+        opt.width = time_width_, opt.height = time_height_;
+        opt.max_wave_pixels = o_.render.max_wave_pixels;
+    }
     NBVH_CHECK(r.apply(opt));
     return median_render_stats(r, o_.repeat).gpu_ms;
 }

@@ -3,6 +3,7 @@
 // equal-time baselines) and study_config.cpp (one configuration: train, decimate, render every variant
 // from every camera). Internal to app/study/; run_study (study_runner.h) is the entry point.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -58,10 +59,12 @@ class StudyRun {
         r.spp = spp;
         r.seed = seed;
         r.neural.path = neural_path_;
+        if (image_wave_paths_) r.max_wave_pixels = std::min(r.max_wave_pixels, image_wave_paths_);
         return r;
     }
     RenderOptions timing_options() const {
         RenderOptions r = image_options(o_.time_spp, o_.render.seed);
+        r.max_wave_pixels = o_.render.max_wave_pixels; // a timed frame's waves are a lone renderer's
         if (time_width_) r.width = time_width_, r.height = time_height_;
         return r;
     }
@@ -132,6 +135,8 @@ class StudyRun {
     std::optional<Scene> hybrid_scene_;
     std::unique_ptr<NeuralModel> model_, previous_model_;
     std::unique_ptr<WavefrontRenderer> hybrid_, hybrid_timing_;
+    // Paths per wave of the image renderers, which live together (run(): a share of the GPU's memory).
+    uint32_t image_wave_paths_ = 0;
 };
 
 } // namespace nbvh::app::study
