@@ -74,7 +74,7 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
     add_sampler_flag(cmd, o.sampler);
     cmd->add_option("--wave-pixels", o.max_wave_pixels,
                     "paths traced per wave (rays per queue; several samples of each pixel while they fit in 32M paths, "
-                    "up to 16; also bounded by the device's buffer, memory and dispatch limits)")
+                    "up to 32; also bounded by the device's buffer, memory and dispatch limits)")
         ->check(CLI::Range(64u, 1u << 26));
 }
 
