@@ -62,7 +62,7 @@ double StudyRun::time_frame(WavefrontRenderer& image_renderer, WavefrontRenderer
     opt.seed = o_.render.seed;
     if (timing_renderer) { // built with timing_options()
         opt.width = time_width_, opt.height = time_height_;
-        opt.max_wave_pixels = o_.render.max_wave_pixels;
+        opt.wave_memory_share = o_.render.wave_memory_share;
     }
     NBVH_CHECK(r.apply(opt));
     return median_render_stats(r, o_.repeat).gpu_ms;

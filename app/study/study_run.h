@@ -3,7 +3,6 @@
 // equal-time baselines) and study_config.cpp (one configuration: train, decimate, render every variant
 // from every camera). Internal to app/study/; run_study (study_runner.h) is the entry point.
 #pragma once
-#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -59,12 +58,12 @@ class StudyRun {
         r.spp = spp;
         r.seed = seed;
         r.neural.path = neural_path_;
-        if (image_wave_paths_) r.max_wave_pixels = std::min(r.max_wave_pixels, image_wave_paths_);
+        r.wave_memory_share = image_memory_share_;
         return r;
     }
     RenderOptions timing_options() const {
         RenderOptions r = image_options(o_.time_spp, o_.render.seed);
-        r.max_wave_pixels = o_.render.max_wave_pixels; // a timed frame's waves are a lone renderer's
+        r.wave_memory_share = o_.render.wave_memory_share; // a timed frame's waves are a lone renderer's
         if (time_width_) r.width = time_width_, r.height = time_height_;
         return r;
     }
@@ -135,8 +134,9 @@ class StudyRun {
     std::optional<Scene> hybrid_scene_;
     std::unique_ptr<NeuralModel> model_, previous_model_;
     std::unique_ptr<WavefrontRenderer> hybrid_, hybrid_timing_;
-    // Paths per wave of the image renderers, which live together (run(): a share of the GPU's memory).
-    uint32_t image_wave_paths_ = 0;
+    // The image renderers live together (each camera's classical one, the hybrid, the decimated scene's):
+    // their waves split half of the GPU's memory (run()).
+    float image_memory_share_ = 0.25f;
 };
 
 } // namespace nbvh::app::study

@@ -30,8 +30,6 @@
 #include "engine/neural/asset_table.h"
 #include "engine/render/decimation.h"
 #include "engine/render/gpu_memory.h"
-#include "engine/render/neural_stage.h"
-#include "engine/render/wave_plan.h"
 #include "engine/render/wavefront.h"
 #include "engine/vk/context.h"
 #include "trainer/compact_hash.h"
@@ -127,7 +125,7 @@ void StudyRun::write_results() const {
           {"leaves_per_round", o_.render.neural.leaves_per_round},
           {"neural_path", render::neural_path_name(neural_path_)},
           {"sampler", render::sampler_name(o_.render.sampler)},
-          {"image_wave_paths", image_wave_paths_},
+          {"image_wave_memory_share", image_memory_share_},
           {"neural_kernel", kernel_},
           {"lods", o_.lods},
           {"exposure", o_.exposure},
@@ -197,15 +195,10 @@ void StudyRun::run() {
     copt.device = vk::parse_device_choice(o_.device);
     ctx_ = std::make_unique<vk::Context>(copt);
     // The image renderers live together (each camera's classical one, the hybrid and the decimated
-    // mesh's): their waves share half of the GPU's memory (one renderer alone may take a quarter,
+    // mesh's): their waves split half of the GPU's memory (a lone renderer may take a quarter,
     // engine/render/wave_plan.h), so a smaller card holds them all at 32 samples per wave (960x540:
-    // ~3 GB classical, ~9 GB hybrid each). Timed frames keep a lone renderer's waves.
-    const uint64_t gpu_bytes = render::wave_limits(ctx_->features()).device_local_bytes;
-    if (gpu_bytes) {
-        const uint64_t per_path = render::wave_bytes_per_path(o_.render) +
-                                  render::neural_scratch_bytes_per_ray(render::effective_leaves_per_round(o_.render.neural));
-        image_wave_paths_ = uint32_t(std::clamp<uint64_t>(gpu_bytes / 2 / (cams_.size() + 2) / per_path, 64, 1u << 30));
-    }
+    // ~3 GB classical, ~9 GB hybrid each). Timed frames keep a lone renderer's share.
+    image_memory_share_ = std::min(o_.render.wave_memory_share, 0.5f / float(cams_.size() + 2));
     accel_ = build_scene_accel(ts_.scene);
     const size_t variants = variants_of(0, o_.lods).size();
     plan();

@@ -52,10 +52,12 @@ WavePlan plan_wave(uint64_t pixels, const RenderOptions& o, const WaveLimits& li
         // The query pass is dispatched indirectly over up to k pairs per ray (not checked on the host).
         if (limits.max_workgroups_x) cap = std::min<uint64_t>(cap, uint64_t(limits.max_workgroups_x) * NB_NEURAL_GROUP / k);
     }
-    // The queues take at most a quarter of the GPU's memory (196 bytes per classical path, ~530 per
-    // hybrid one with 2 leaves per round: an 8 GiB card holds ~11M / ~4M paths).
+    // The queues take at most wave_memory_share of the GPU's memory (a quarter by default; 196 bytes per
+    // classical path, ~530 per hybrid one with 2 leaves per round: a quarter of an 8 GiB card holds
+    // ~11M / ~4M paths).
     if (limits.device_local_bytes)
-        cap = std::min<uint64_t>(cap, limits.device_local_bytes / 4 / wave_bytes_per_path(o));
+        cap = std::min<uint64_t>(cap, uint64_t(double(limits.device_local_bytes) * o.wave_memory_share) /
+                                          wave_bytes_per_path(o));
     cap = std::clamp<uint64_t>(cap, 64, 0xFFFFFFFFull);
     WavePlan plan;
     plan.samples = cap >= pixels ? uint32_t(std::min<uint64_t>(samples, cap / pixels)) : 1u;

@@ -58,6 +58,8 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
         throw Error(strfmt("image size %ux%u is out of range (1..16384 per side)", options_.width, options_.height));
     if (options_.spp == 0) throw Error("--spp must be at least 1");
     if (options_.max_depth == 0 || options_.max_depth > 256) throw Error("--max-depth must be in 1..256");
+    if (!(options_.wave_memory_share > 0.0f && options_.wave_memory_share <= 1.0f))
+        throw Error(strfmt("wave memory share %g is out of range (0, 1]", double(options_.wave_memory_share)));
     const vk::DeviceFeatures& dev = ctx_.features();
     if (!dev.scalar_layout) throw Error("the Vulkan device lacks scalarBlockLayout, which every pass needs");
     const uint64_t pixels = uint64_t(options_.width) * options_.height;
@@ -258,6 +260,7 @@ bool WavefrontRenderer::apply(const RenderOptions& o) {
     const bool overrides = n.roughness >= 0.0f || n.metallic >= 0.0f;
     const bool swap = n.model && cn.model && n.model != cn.model && neural_;
     if (o.width != c.width || o.height != c.height || o.max_wave_pixels != c.max_wave_pixels ||
+        o.wave_memory_share != c.wave_memory_share ||
         (n.model != cn.model && !swap) || n.path != cn.path ||
         (n.model && effective_leaves_per_round(n) != neural_->leaves_per_round()) ||
         (n.classical && overrides) != classical_overrides_ || (n.model && !features_.neural && !n.classical) ||

@@ -43,6 +43,9 @@ struct RenderOptions {
     // frame_depths.md, README.md). Queue memory at 32M: ~6.5 GB classical, ~17.7 GB hybrid (2 leaves per
     // round), bounded by a quarter of the GPU's memory.
     uint32_t max_wave_pixels = 1u << 25;
+    // Share of the GPU's device-local memory the wave's queues may take (wave_plan.h): a lone renderer a
+    // quarter; `nbvh study`'s image renderers, which live together, split half of it between them.
+    float wave_memory_share = 0.25f;
     // Secondary and shadow rays are traced bin by bin of (direction octant, origin cell) (shared/
     // wavefront_gpu.h NB_RS_*, passes/ray_sort.comp; the hybrid's neural traversal op 0 too): same image,
     // coherent warps. --sort-rays.

@@ -53,7 +53,7 @@ void expect_within_limits(uint64_t pixels, const RenderOptions& o, const WaveLim
         EXPECT_LE(cap * 2 * o.max_depth, 1ull << 31);
         const uint64_t bytes = 196 + (hybrid ? 2 * 64 + 2 * k * 52 : 0); // queues + ray order + neural state + pending pairs
         if (l.device_local_bytes) {
-            EXPECT_LE(bytes * cap, l.device_local_bytes / 4);
+            EXPECT_LE(bytes * cap, uint64_t(double(l.device_local_bytes) * o.wave_memory_share));
         }
         if (l.max_workgroups_x) {
             EXPECT_LE(cap, uint64_t(l.max_workgroups_x) * 64) << "one invocation per path per dispatch";
@@ -87,6 +87,27 @@ TEST(WavePlan, OneSamplePerCallKeepsOneSamplesQueues) {
     EXPECT_EQ(p.samples, 1u);
     EXPECT_EQ(p.capacity, P1080);
     EXPECT_EQ(plan_wave(P1080, opts(3), h100()).samples, 3u);
+}
+
+// A renderer that shares the GPU with others (`nbvh study`'s image renderers: half of the memory
+// between 5) takes fewer samples per wave, within its share: 80 GiB / 10 = 8 GiB at ~532 bytes a hybrid
+// path is 16.1M paths, 31 samples of 960x540; at a twentieth, 15.
+TEST(WavePlan, AMemoryShareBoundsTheWave) {
+    const NeuralModel model;
+    for (float share : {0.1f, 0.05f}) {
+        RenderOptions o = opts(512, &model);
+        o.wave_memory_share = share;
+        const WavePlan p = plan_wave(960ull * 540, o, h100());
+        expect_within_limits(960ull * 540, o, h100(), p);
+        EXPECT_EQ(p.samples, share == 0.1f ? 31u : 15u) << share;
+        EXPECT_LE(uint64_t(p.capacity) * wave_bytes_per_path(o), uint64_t(80.0 * double(GIB) * share));
+    }
+    const WavePlan classical = plan_wave(960ull * 540, [] {
+        RenderOptions o = opts(512);
+        o.wave_memory_share = 0.1f;
+        return o;
+    }(), h100());
+    EXPECT_EQ(classical.samples, 32u); // 196 bytes a path: 43.8M paths fit, the 32-sample bound holds
 }
 
 TEST(WavePlan, SmallImagesStopAtThirtyTwoSamples) {
