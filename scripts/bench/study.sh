@@ -5,7 +5,7 @@
 #      REF_SPP (compared images and reference), BUDGET (minutes; configurations that would end later are
 #      not started and are listed in study.json), BACKEND (cuda), DEVICE (gpu), TIME_WIDTH, TIME_HEIGHT.
 # The sweep: nodes 1000,2395,8000 x hash 2^14,2^16,2^18, 3 LoDs each (+ the LoD switch), 3 cameras, images
-# 960x540 at 512 spp against an 8192-spp classical reference, frame times at 1920x1080, 4 spp, median of 3;
+# 960x540 at 1024 spp against an 8192-spp classical reference, frame times at 1920x1080, 4 spp, median of 3;
 # equal-memory decimation and equal-time classical baselines; the raised leaf budget (64) on the middle
 # configuration. Writes OUT/study.json, study.csv, camera 0's reference / hybrid / decimated PNGs and log.txt.
 # Plots and table afterwards, on the build machine: scripts/bench/plot_study.py OUT/study.json results/study/SCENE
@@ -37,7 +37,7 @@ esac
   nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null || echo "no nvidia-smi"
   "$NBVH" study "${SCENE[@]}" --out "$OUT" --backend "${BACKEND:-cuda}" --device "${DEVICE:-gpu}" \
     --nodes "${NODES:-1000,2395,8000}" --hash-log2 "${HASH:-14,16,18}" --lods "${LODS:-3}" --cameras "${CAMERAS:-3}" \
-    --width "${WIDTH:-960}" --height "${HEIGHT:-540}" --spp "${SPP:-512}" --ref-spp "${REF_SPP:-8192}" \
+    --width "${WIDTH:-960}" --height "${HEIGHT:-540}" --spp "${SPP:-1024}" --ref-spp "${REF_SPP:-8192}" \
     --time-width "${TIME_WIDTH:-1920}" --time-height "${TIME_HEIGHT:-1080}" --time-spp 4 --repeat 3 --max-depth 8 \
     --budget-minutes "${BUDGET:-9.5}" --save-images "$@"
 } 2>&1 | tee "$OUT/log.txt"
