@@ -188,8 +188,8 @@ def table(study):
                   f"per camera, {sum(bool(r['converged']) for r in means)} of {len(means)} means (`converged` in "
                   "study.json and study.csv).", ""]
     lines += ["| nodes | hash | LoD | memory MiB | vs mesh+BLAS | training s | frame ms | x classical | queries/ray | rays capped | FLIP | "
-              "decimated FLIP (equal memory) | classical FLIP (equal time, spp) |",
-              "| ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
+              "FLIP, same seed | decimated FLIP (equal memory) | classical FLIP (equal time, spp) |",
+              "| ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
     dec = {r["config"]: r for r in rows_of(study, "decimated")}
     for r in sorted(rows_of(study, "lod") + rows_of(study, "switch") + rows_of(study, "cap"),
                     key=lambda r: (r["config"], r["variant"] != "lod", r["lod"], r["secondary_lod"])):
@@ -203,13 +203,17 @@ def table(study):
             f"| {r['nodes']} | 2^{r['hash_log2']} | {lod} | {r['memory_bytes'] / MIB:.2f} | {fmt(r['compression'], '.1f')}x | "
             f"{fmt(r['train_seconds'], '.1f')} | {fmt(r['frame_ms'], '.3f')} | {fmt(r['ratio_to_classical'], '.2f')} | "
             f"{fmt(r['queries_per_ray'], '.2f')} | {pct(r.get('leaf_cap_fraction'))} | {fmt(r['flip'], '.4f')}{mark} | "
+            f"{fmt(r.get('flip_same_seed'), '.4f')} | "
             + (f"{d['flip']:.4f} ({d['triangles']} tris)" if d else "") + " | "
             + (f"{r['equal_time_flip']:.4f} ({r['equal_time_spp']})" if r.get("equal_time_flip") is not None else "")
             + " |")
     lines += ["", "The raised leaf budget row: how much the default per-ray budget changes the image (same seed and spp as "
               "LoD 0, so noise cancels) and what more leaves cost in time; its extra queries per ray are the leaves "
               "the default budget cuts off. Rays capped: the share of path and shadow rays that the leaf budget left with a "
-              "leaf in front of their best hit.", "", "`*`: within twice the noise floor (not distinguishable from noise at this spp). Memory: the model with "
+              "leaf in front of their best hit.", "", "FLIP, same seed: against the classical render of the same seed and spp "
+              "instead of the reference: the noise the two images share cancels, so it lies closer to the converged error "
+              "where the hybrid's paths stay correlated with the triangles' (how close, per scene: results/study/README.md, "
+              "Convergence).", "", "`*`: within twice the noise floor (not distinguishable from noise at this spp). Memory: the model with "
               "only this LoD's nodes (grid, MLP and its transposed copy, level table, nodes and their bounds, asset "
               "table); every LoD resident: see study.json `resident_bytes`.", ""]
     return "\n".join(lines)

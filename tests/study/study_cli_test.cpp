@@ -176,6 +176,7 @@ TEST(Study, TinySweepWritesCsvJsonAndPlots) {
     EXPECT_NE(text.str().find("noise floor"), std::string::npos);
     EXPECT_NE(text.str().find("that meet the issue's rule"), std::string::npos) << "per-camera rule count";
     EXPECT_NE(text.str().find("llvmpipe"), std::string::npos) << "the device is named";
+    EXPECT_NE(text.str().find("FLIP, same seed"), std::string::npos) << "the shared-seed column";
 }
 
 // A time budget stops before a configuration that would end past it; what ran is written, marked incomplete.
