@@ -65,7 +65,7 @@ Timed time_renders(const vk::Context& ctx, const Scene& scene, const SceneAccel&
 void run_bench(const BenchArgs& a) {
     check_output_path(a.json, "--json", {a.scene, a.model, a.env});
     vk::ContextOptions copt;
-    copt.device = vk::parse_device_choice(a.device);
+    copt.set_device(a.device);
     render::RenderOptions options = a.options;
     options.neural.path = render::parse_neural_path(a.neural_path);
     if (a.repeat == 0) throw Error("--repeat must be at least 1");
@@ -160,7 +160,9 @@ void add_bench_command(CLI::App& app, const std::string& command_line) {
     cmd->add_option("scene", args->scene, "glTF/GLB file, or 'default' for the built-in scene")->required();
     cmd->add_option("--model", args->model, "N-BVH model (.nbvh) of the scene's neural asset")->required();
     add_render_option_flags(cmd, args->options);
-    cmd->add_option("--device", args->device, "Vulkan device: auto, gpu or cpu (lavapipe)");
+    cmd->add_option("--device", args->device,
+                    "Vulkan device: auto, gpu, gpu:N (the N-th GPU in PCI order, nvidia-smi's number) "
+                    "or cpu (lavapipe)");
     cmd->add_option("--repeat", args->repeat, "timed renders per configuration (the median is reported)")
         ->check(CLI::Range(1u, 1000u));
     cmd->add_option("--json", args->json, "write the table (and per-pass GPU times) as JSON");

@@ -208,7 +208,7 @@ void run_bench_features(const Args& a) {
     check_output_path(a.markdown, "--markdown", a.scenes);
     if (!a.json.empty() && a.json == a.markdown) throw Error("--json and --markdown name the same file");
     vk::ContextOptions copt;
-    copt.device = vk::parse_device_choice(a.device);
+    copt.set_device(a.device);
     vk::Context ctx(copt);
     const std::string device = ctx.features().device_name;
     const std::string driver = ctx.features().driver_name + " " + ctx.features().driver_info;
@@ -257,7 +257,9 @@ void add_bench_features_command(CLI::App& app, const std::string& command_line) 
     cmd->add_option("--seed", args->options.seed, "random seed");
     cmd->add_option("--repeat", args->repeat, "timed frames per configuration (the median is reported)")
         ->check(CLI::Range(1u, 1000u));
-    cmd->add_option("--device", args->device, "Vulkan device: auto, gpu or cpu (lavapipe)");
+    cmd->add_option("--device", args->device,
+                    "Vulkan device: auto, gpu, gpu:N (the N-th GPU in PCI order, nvidia-smi's number) "
+                    "or cpu (lavapipe)");
     cmd->add_option("--env", args->env, "environment map (.hdr or .exr), or 'none' (the scene's lights only)");
     cmd->add_option("--json", args->json, "write every figure (and the frames' GPU times) as JSON");
     cmd->add_option("--markdown", args->markdown, "write the table as markdown");

@@ -95,7 +95,7 @@ void run_converge(const ConvergeArgs& a) {
     const uint32_t ref_spp = a.ref_spp.value_or(uint32_t(std::min<uint64_t>(4ull * a.options.spp, 1u << 20)));
     const std::optional<float> fixed_exposure = parse_exposure(a.exposure);
     vk::ContextOptions copt;
-    copt.device = vk::parse_device_choice(a.device);
+    copt.set_device(a.device);
     render::RenderOptions base = a.options;
     base.neural.path = render::parse_neural_path(a.neural_path);
     base.neural.lod = a.lod;
@@ -220,7 +220,9 @@ void add_converge_command(CLI::App& app, const std::string& command_line) {
         ->check(CLI::Range(1u, 1u << 20));
     cmd->add_option("--lod", args->lod, "N-BVH level of detail of camera rays (0 = finest)");
     cmd->add_option("--secondary-lod", args->secondary_lod, "LoD after the first hit: coarsest, same or 0..7");
-    cmd->add_option("--device", args->device, "Vulkan device: auto, gpu or cpu (lavapipe)");
+    cmd->add_option("--device", args->device,
+                    "Vulkan device: auto, gpu, gpu:N (the N-th GPU in PCI order, nvidia-smi's number) "
+                    "or cpu (lavapipe)");
     cmd->add_option("--json", args->json, "write the table as JSON (device, commit, command line inside)");
     cmd->add_option("--csv", args->csv, "write the table as CSV");
     cmd->add_option("--neural-path", args->neural_path, "MLP implementation: auto, scalar or coopmat");

@@ -60,7 +60,10 @@ void add_study_command(CLI::App& app, const std::string& command_line) {
         ->check(CLI::Range(1u, 16384u));
     cmd->add_option("--time-height", o->time_height, "height of the timed frames (default: --height)")
         ->check(CLI::Range(1u, 16384u));
-    cmd->add_option("--device", o->device, "Vulkan device: auto, gpu or cpu (lavapipe)");
+    cmd->add_option(
+        "--device", o->device,
+        "Vulkan device: auto, gpu, gpu:N (the N-th GPU in PCI order, nvidia-smi's number; the CUDA "
+        "trainer then uses the same GPU) or cpu (lavapipe)");
     cmd->add_option("--env", o->env, "environment map (.hdr or .exr), or 'none' (the scene's lights only)");
     cmd->add_option("--env-rotation", o->env_rotation, "rotate the environment about +y by this many degrees")
         ->check(CLI::Range(-3600.0f, 3600.0f));

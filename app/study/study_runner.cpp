@@ -158,6 +158,7 @@ void StudyRun::run() {
     time_width_ = o_.time_width;
     time_height_ = o_.time_height;
     neural_path_ = render::parse_neural_path(o_.neural_path);
+    (void)vk::parse_device_spec(o_.device); // a bad --device fails before the scene loads
     fixed_exposure_ = parse_exposure(o_.exposure);
     backend_ = resolve_backend(parse_backend(o_.backend));
     ts_ = load_training_scene(o_.scene, o_.neural_glob, o_.asset_glob);
@@ -181,7 +182,13 @@ void StudyRun::run() {
         source_triangles_ += ts_.scene.meshes[m].triangle_count();
         source_bytes_ += render::mesh_gpu_bytes(ts_.scene.meshes[m]);
     }
+    vk::ContextOptions copt;
+    copt.set_device(o_.device);
+    ctx_ = std::make_unique<vk::Context>(copt);
 #if defined(NBVH_HAVE_CUDA)
+    // --device gpu:N: train on the GPU that renders (matched by UUID), not on CUDA's first device.
+    if (backend_ == BackendChoice::cuda && copt.gpu_index >= 0)
+        cuda_use_device_uuid(ctx_->features().device_uuid);
     if (backend_ == BackendChoice::cuda) train_device_ = cuda_device_name();
 #endif
     if (train_device_.empty())
@@ -191,9 +198,6 @@ void StudyRun::run() {
                 : strfmt("%u CPU threads",
                          o_.threads ? o_.threads : std::max(1u, std::thread::hardware_concurrency()));
 
-    vk::ContextOptions copt;
-    copt.device = vk::parse_device_choice(o_.device);
-    ctx_ = std::make_unique<vk::Context>(copt);
     // The image renderers live together (each camera's classical one, the hybrid and the decimated
     // mesh's): their waves split half of the GPU's memory (a lone renderer may take a quarter,
     // engine/render/wave_plan.h), so a smaller card holds them all at 32 samples per wave (960x540:

@@ -36,7 +36,7 @@ void run_viewer(const ViewerArgs& a) {
     auto view = load_viewer_scene(a.scene, so, model, a.model, float(width) / float(height));
 
     vk::ContextOptions copt;
-    copt.device = vk::parse_device_choice(a.device);
+    copt.set_device(a.device);
     copt.instance_extensions = Window::required_instance_extensions();
     copt.device_extensions = {VK_KHR_SWAPCHAIN_EXTENSION_NAME};
     vk::Context ctx(copt);

@@ -56,6 +56,18 @@ DeviceChoice parse_device_choice(std::string_view text) {
     throw Error("unknown --device '" + std::string(text) + "' (expected auto, gpu or cpu)");
 }
 
+DeviceSpec parse_device_spec(std::string_view text) {
+    constexpr std::string_view prefix = "gpu:";
+    if (text.substr(0, prefix.size()) != prefix) return {parse_device_choice(text), -1};
+    const std::string_view digits = text.substr(prefix.size());
+    const bool ok = !digits.empty() && digits.size() <= 4 &&
+                    std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; });
+    if (!ok)
+        throw Error("unknown --device '" + std::string(text) +
+                    "' (expected auto, gpu, gpu:N with N the GPU's number from 0, or cpu)");
+    return {DeviceChoice::gpu, std::stoi(std::string(digits))};
+}
+
 const char* device_choice_name(DeviceChoice c) {
     switch (c) {
     case DeviceChoice::gpu: return "gpu";
@@ -101,7 +113,7 @@ static bool env_flag(const char* name, bool fallback) {
 Context::Context(const ContextOptions& options) : debug_(std::make_unique<Debug>()) {
     try {
         create_instance(env_flag("NBVH_VALIDATION", options.validation), options.instance_extensions);
-        pick_physical_device(options.device);
+        pick_physical_device(options.device, options.device == DeviceChoice::gpu ? options.gpu_index : -1);
         create_device(options.device_extensions);
     } catch (...) {
         destroy();

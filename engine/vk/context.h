@@ -34,14 +34,28 @@ const char* result_name(VkResult result);
 
 namespace nbvh::vk {
 
-// --device auto|gpu|cpu. auto prefers a real GPU (discrete, then integrated, then virtual) and falls
-// back to a CPU implementation (Mesa lavapipe); gpu fails without a GPU; cpu picks lavapipe.
+// --device auto|gpu|gpu:N|cpu. auto prefers a real GPU (discrete, then integrated, then virtual) and falls
+// back to a CPU implementation (Mesa lavapipe); gpu fails without a GPU; cpu picks lavapipe. gpu:N takes
+// the N-th usable GPU (from 0) in PCI bus order, nvidia-smi's numbering (the driver's enumeration order
+// where a GPU does not report its PCI address: VK_EXT_pci_bus_info), so that several processes can share
+// one host's GPUs (scripts/bench/study_multi.sh).
 enum class DeviceChoice { automatic, gpu, cpu };
-DeviceChoice parse_device_choice(std::string_view text); // throws Error on anything else
+DeviceChoice parse_device_choice(std::string_view text); // auto|gpu|cpu; throws Error on anything else
 const char* device_choice_name(DeviceChoice choice);
+struct DeviceSpec {
+    DeviceChoice choice = DeviceChoice::automatic;
+    int gpu_index = -1; // gpu:N; -1: the best GPU
+};
+DeviceSpec parse_device_spec(std::string_view text); // auto|gpu|gpu:N|cpu; throws Error on anything else
 
 struct ContextOptions {
     DeviceChoice device = DeviceChoice::automatic;
+    int gpu_index = -1; // with DeviceChoice::gpu: the N-th GPU in PCI bus order (-1: the best one)
+    void set_device(std::string_view text) { // from a --device argument (parse_device_spec)
+        const DeviceSpec s = parse_device_spec(text);
+        device = s.choice;
+        gpu_index = s.gpu_index;
+    }
     // Khronos validation layer + debug messenger. Also switched on by NBVH_VALIDATION=1 in the
     // environment (NBVH_VALIDATION=0 switches it off). Debug builds default to on.
 #ifdef NDEBUG
@@ -67,6 +81,9 @@ struct CoopMatrixShape {
 // What the chosen device can do. Every `bool` here is also *enabled* on the logical device when true.
 struct DeviceFeatures {
     std::string device_name;
+    // VkPhysicalDeviceVulkan11Properties::deviceUUID as 8-4-4-4-12 hex digits: on NVIDIA the GPU's UUID
+    // (nvidia-smi -L, CUDA's cudaDeviceProp::uuid), which is how the CUDA trainer finds the same GPU.
+    std::string device_uuid;
     std::string driver_name; // e.g. "llvmpipe" / "NVIDIA" (VkPhysicalDeviceVulkan12Properties)
     std::string driver_info; // driver version text as the driver reports it
     uint32_t api_version = 0;
@@ -159,7 +176,7 @@ private:
     struct Debug; // heap-held so the messenger's user pointer survives moves
     void destroy();
     void create_instance(bool validation, const std::vector<std::string>& extra_extensions);
-    void pick_physical_device(DeviceChoice choice);
+    void pick_physical_device(DeviceChoice choice, int gpu_index);
     void create_device(const std::vector<std::string>& extra_extensions);
 
     std::unique_ptr<Debug> debug_;

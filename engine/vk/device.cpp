@@ -4,7 +4,10 @@
 #include "engine/core/log.h"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
+#include <optional>
+#include <string>
 
 namespace nbvh::vk {
 
@@ -65,6 +68,54 @@ const char* component_name(VkComponentTypeNV t) {
     }
 }
 
+// PCI address (domain, bus, device, function) where the driver reports it (VK_EXT_pci_bus_info).
+std::optional<std::array<uint32_t, 4>> pci_address(VkPhysicalDevice pd) {
+    if (!has_extension(device_extensions(pd), VK_EXT_PCI_BUS_INFO_EXTENSION_NAME)) return std::nullopt;
+    VkPhysicalDevicePCIBusInfoPropertiesEXT pci{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PCI_BUS_INFO_PROPERTIES_EXT};
+    VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &pci};
+    vkGetPhysicalDeviceProperties2(pd, &p2);
+    return std::array<uint32_t, 4>{pci.pciDomain, pci.pciBus, pci.pciDevice, pci.pciFunction};
+}
+
+struct Candidate {
+    VkPhysicalDevice device;
+    std::string name;
+    std::optional<std::array<uint32_t, 4>> pci;
+};
+
+// --device gpu:N: the N-th usable GPU in PCI bus order (nvidia-smi's numbering), or in the driver's
+// enumeration order when any of them does not report its PCI address.
+VkPhysicalDevice nth_gpu_in_pci_order(std::vector<Candidate> gpus, int n, const std::string& seen) {
+    const bool all_pci =
+        std::all_of(gpus.begin(), gpus.end(), [](const Candidate& c) { return c.pci.has_value(); });
+    if (all_pci)
+        std::stable_sort(gpus.begin(), gpus.end(),
+                         [](const Candidate& a, const Candidate& b) { return *a.pci < *b.pci; });
+    if (gpus.empty())
+        throw Error(
+            strfmt("--device gpu:%d: no usable GPU (Vulkan 1.2, scalar block layout, compute); Vulkan "
+                   "devices found: %s",
+                   n, seen.c_str()));
+    if (n >= int(gpus.size()))
+        throw Error(
+            strfmt("--device gpu:%d: this machine has %zu usable GPU(s), gpu:0 to gpu:%zu; Vulkan devices "
+                   "found: %s",
+                   n, gpus.size(), gpus.size() - 1, seen.c_str()));
+    if (!all_pci)
+        log_info("--device gpu:%d: a GPU does not report its PCI address; counting in the driver's order", n);
+    return gpus[size_t(n)].device;
+}
+
+std::string format_uuid(const uint8_t (&u)[VK_UUID_SIZE]) {
+    std::string s;
+    for (int i = 0; i < int(VK_UUID_SIZE); ++i) {
+        if (i == 4 || i == 6 || i == 8 || i == 10) s += '-';
+        s += strfmt("%02x", unsigned(u[i]));
+    }
+    return s;
+}
+
 } // namespace
 
 std::string CoopMatrixShape::describe() const {
@@ -74,10 +125,10 @@ std::string CoopMatrixShape::describe() const {
 
 std::string DeviceFeatures::summary() const {
     auto yn = [](bool b) { return b ? "yes" : "no"; };
-    std::string s = strfmt("device: %s (%s, %s%s), Vulkan %u.%u.%u\n", device_name.c_str(),
-                           driver_name.c_str(), driver_info.c_str(), is_cpu ? ", CPU" : "",
-                           VK_API_VERSION_MAJOR(api_version), VK_API_VERSION_MINOR(api_version),
-                           VK_API_VERSION_PATCH(api_version));
+    std::string s =
+        strfmt("device: %s (%s, %s%s), Vulkan %u.%u.%u, uuid %s\n", device_name.c_str(), driver_name.c_str(),
+               driver_info.c_str(), is_cpu ? ", CPU" : "", VK_API_VERSION_MAJOR(api_version),
+               VK_API_VERSION_MINOR(api_version), VK_API_VERSION_PATCH(api_version), device_uuid.c_str());
     s += strfmt("  fp16 %s, int8 %s, int16 %s, int64 %s, 16-bit storage %s, 8-bit storage %s, scalar layout %s\n",
                 yn(fp16), yn(int8), yn(int16), yn(int64), yn(storage16), yn(storage8), yn(scalar_layout));
     s += strfmt("  buffer device address %s, memory model %s, partially bound descriptors %s\n",
@@ -94,7 +145,7 @@ std::string DeviceFeatures::summary() const {
     return s;
 }
 
-void Context::pick_physical_device(DeviceChoice choice) {
+void Context::pick_physical_device(DeviceChoice choice, int gpu_index) {
     uint32_t count = 0;
     NBVH_VK_CHECK(vkEnumeratePhysicalDevices(instance_, &count, nullptr));
     std::vector<VkPhysicalDevice> devices(count);
@@ -104,6 +155,7 @@ void Context::pick_physical_device(DeviceChoice choice) {
 
     std::string seen;
     int best_rank = -1;
+    std::vector<Candidate> gpus; // usable GPUs, for gpu:N
     for (VkPhysicalDevice pd : devices) {
         VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
         VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
@@ -124,11 +176,19 @@ void Context::pick_physical_device(DeviceChoice choice) {
         bool cpu = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
         if (choice == DeviceChoice::cpu && !cpu) continue;
         if (choice == DeviceChoice::gpu && cpu) continue;
+        if (gpu_index >= 0) {
+            gpus.push_back({pd, props.deviceName, pci_address(pd)});
+            continue;
+        }
         int rank = type_rank(props.deviceType);
         if (rank > best_rank) {
             best_rank = rank;
             physical_ = pd;
         }
+    }
+    if (gpu_index >= 0) {
+        physical_ = nth_gpu_in_pci_order(gpus, gpu_index, seen);
+        return;
     }
     if (!physical_) {
         const char* want = choice == DeviceChoice::gpu   ? "a GPU"
@@ -173,6 +233,7 @@ void Context::create_device(const std::vector<std::string>& extra_extensions) {
 
     DeviceFeatures& d = features_;
     d.device_name = props.deviceName;
+    d.device_uuid = format_uuid(p11.deviceUUID);
     d.driver_name = p12.driverName;
     d.driver_info = p12.driverInfo;
     d.api_version = props.apiVersion;

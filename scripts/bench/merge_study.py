@@ -50,7 +50,10 @@ def main(argv):
         for c in s["configs"]:
             merged["configs"].append(dict(c, config=remap[c["config"]]))
         for key in ("rows", "mean_rows"):
-            merged[key] += [dict(r, config=remap.get(r["config"], r["config"])) for r in s[key]]
+            # Rows of no configuration (the classical reference rows, config -1) are the same in every part
+            # (checked above through the noise floors): the first part's are kept, once.
+            merged[key] += [dict(r, config=remap[r["config"]]) if r["config"] in remap else dict(r)
+                            for r in s[key] if r["config"] in remap or p == paths[0]]
         first, last = offset + 1, offset + len(s["configs"])
         commits.append(f"{s['commit']} (configs {first}-{last})")
         merged["parts"].append({"file": p, "commit": s["commit"], "command_line": s["command_line"],

@@ -19,16 +19,16 @@ TMP=${TMPDIR:-/tmp}/nbvh_study
 mkdir -p "$TMP"
 source scripts/bench/lib.sh
 if [ ! -x "$NBVH" ] && [ -f "$NBVH.xz" ]; then # a carried, xz-packed binary
-  unpack "$NBVH.xz" "$TMP/nbvh" && chmod +x "$TMP/nbvh" && NBVH=$TMP/nbvh
+  unpack "$NBVH.xz" "$TMP/nbvh.$$" && chmod +x "$TMP/nbvh.$$" && NBVH=$TMP/nbvh.$$ # per process: parts run in parallel
 fi
 case "$WHICH" in
   default) SCENE=(default) ;;
-  dragon)
-    unpack .device/study/dragon/dragon_vrip.glb.xz "$TMP/dragon_vrip.glb"
+  dragon) # NBVH_STUDY_UNPACKED=1 (study_multi.sh): unpacked once before the parallel parts
+    [ "${NBVH_STUDY_UNPACKED:-0}" = 1 ] || unpack .device/study/dragon/dragon_vrip.glb.xz "$TMP/dragon_vrip.glb"
     SCENE=("$TMP/dragon_vrip.glb" --neural '*') ;;
   chess)
     # The paper's camera and environment (scripts/bench/chess.sh): 48 neural pieces, 14 assets, one model.
-    unpack .device/study/chess/abeautifulgame.glb.xz "$TMP/abeautifulgame.glb"
+    [ "${NBVH_STUDY_UNPACKED:-0}" = 1 ] || unpack .device/study/chess/abeautifulgame.glb.xz "$TMP/abeautifulgame.glb"
     SCENE=("$TMP/abeautifulgame.glb" --camera 0.600,0.358,0.179,-0.197,-0.197,-0.057,45
            --env .device/study/chess/photo_studio_loft_hall_512x256.hdr --env-rotation 285 --exposure 0) ;;
   *) echo "study.sh: scene must be default, dragon or chess" >&2; exit 2 ;;

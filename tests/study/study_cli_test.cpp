@@ -261,6 +261,55 @@ TEST(Study, ASweepsLaterConfigurationRendersAsAFreshStudy) {
     EXPECT_NE(first[0]["flip_same_seed"], swept[0]["flip_same_seed"]);
 }
 
+// scripts/bench/study_multi.sh: parts of the sweep run in parallel (here two lavapipe processes standing in
+// for two GPUs) and merge_study.py joins them: every configuration once, the reference rows once.
+TEST(Study, PartsRunInParallelAndMergeIntoOneStudy) {
+    const fs::path dir = nbvh::test::temp_dir("study_multi_" + std::to_string(::getpid())) / "out";
+    const auto r =
+        nbvh::test::run_command("/usr/bin/env",
+                                {"GPUS=2",
+                                 "PART_DEVICE=cpu",
+                                 "BACKEND=cpu",
+                                 "NBVH=" + nbvh::test::nbvh_exe().string(),
+                                 "PARTS=31:12 63:12",
+                                 "WIDTH=32",
+                                 "HEIGHT=32",
+                                 "SPP=2",
+                                 "REF_SPP=8",
+                                 "TIME_WIDTH=32",
+                                 "TIME_HEIGHT=32",
+                                 "LODS=1",
+                                 "CAMERAS=2",
+                                 "bash",
+                                 (nbvh::test::source_dir() / "scripts/bench/study_multi.sh").string(),
+                                 "default",
+                                 dir.string(),
+                                 "--steps",
+                                 "20",
+                                 "--batch",
+                                 "256",
+                                 "--threads",
+                                 "1"},
+                                300.0);
+    ASSERT_EQ(r.exit_code, 0) << r.describe();
+    std::ifstream f(dir / "study.json");
+    ASSERT_TRUE(f.good()) << r.describe();
+    const nlohmann::json j = nlohmann::json::parse(f);
+    EXPECT_TRUE(j.at("complete").get<bool>());
+    ASSERT_EQ(j.at("configs").size(), 2u);
+    EXPECT_EQ(j.at("configs")[0].at("nodes_target").get<int>(), 31);
+    EXPECT_EQ(j.at("configs")[1].at("nodes_target").get<int>(), 63);
+    EXPECT_EQ(j.at("parts").size(), 2u);
+    int classical = 0, lod = 0;
+    for (const auto& row : j.at("rows")) {
+        if (row.at("variant") == "classical") ++classical;
+        if (row.at("variant") == "lod") ++lod;
+    }
+    EXPECT_EQ(classical, 2) << "one reference row per camera, not one per part";
+    EXPECT_EQ(lod, 4) << "2 configurations x 2 cameras";
+    EXPECT_TRUE(fs::exists(dir / "part_0" / "study.json") && fs::exists(dir / "part_1" / "study.json"));
+}
+
 TEST(Study, BadOptionsFailBeforeAnyWork) {
     const fs::path dir = nbvh::test::temp_dir("study_bad");
     auto r = run_nbvh({"study", "default", "--out", (dir / "o").string(), "--device", "cpu", "--spp", "64",
@@ -270,6 +319,12 @@ TEST(Study, BadOptionsFailBeforeAnyWork) {
     EXPECT_EQ(check_clean_error(r, {"--out"}), "") << r.describe();
     r = run_nbvh({"study", "default", "--out", (dir / "o").string(), "--hash-log2", "2"});
     EXPECT_EQ(check_clean_error(r, {"--hash-log2"}), "") << r.describe();
+    r = run_nbvh({"study", "default", "--out", (dir / "o").string(), "--device", "gpu:x"});
+    EXPECT_EQ(check_clean_error(r, {"--device", "gpu:x"}), "") << r.describe();
+    // gpu:N beyond the machine's GPUs (on CI: any N, lavapipe is no GPU) fails before the first training.
+    r = run_nbvh(
+        {"study", "default", "--out", (dir / "o").string(), "--device", "gpu:63", "--backend", "cpu"});
+    EXPECT_EQ(check_clean_error(r, {"--device gpu:63"}), "") << r.describe();
     EXPECT_FALSE(fs::exists(dir / "o" / "study.json"));
 }
 

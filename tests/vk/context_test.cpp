@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <numeric>
 
 using namespace nbvh::vk;
@@ -70,6 +71,62 @@ TEST(VkContext, DeviceChoiceParsing) {
     EXPECT_EQ(parse_device_choice("cpu"), DeviceChoice::cpu);
     EXPECT_THROW(parse_device_choice("GPU0"), nbvh::Error);
     EXPECT_THROW(parse_device_choice(""), nbvh::Error);
+    EXPECT_THROW(parse_device_choice("gpu:0"), nbvh::Error) << "an index is parse_device_spec's";
+}
+
+TEST(VkContext, DeviceSpecParsing) {
+    for (const char* plain : {"auto", "gpu", "cpu"}) {
+        const DeviceSpec s = parse_device_spec(plain);
+        EXPECT_EQ(s.choice, parse_device_choice(plain));
+        EXPECT_EQ(s.gpu_index, -1);
+    }
+    EXPECT_EQ(parse_device_spec("gpu:0").choice, DeviceChoice::gpu);
+    EXPECT_EQ(parse_device_spec("gpu:0").gpu_index, 0);
+    EXPECT_EQ(parse_device_spec("gpu:7").gpu_index, 7);
+    EXPECT_EQ(parse_device_spec("gpu:0012").gpu_index, 12);
+    for (const char* bad :
+         {"gpu:", "gpu:-1", "gpu:x", "gpu:1x", "gpu: 1", "gpu:99999", "cpu:0", "gpu0", "GPU:1"})
+        EXPECT_THROW(parse_device_spec(bad), nbvh::Error) << bad;
+    ContextOptions o;
+    o.set_device("gpu:3");
+    EXPECT_EQ(o.device, DeviceChoice::gpu);
+    EXPECT_EQ(o.gpu_index, 3);
+    o.set_device("cpu");
+    EXPECT_EQ(o.device, DeviceChoice::cpu);
+    EXPECT_EQ(o.gpu_index, -1);
+}
+
+// The device UUID (how `nbvh study --device gpu:N` finds the same GPU in CUDA) is reported in CUDA's form.
+TEST(VkContext, DeviceUuidIsFormattedLikeCuda) {
+    Context ctx = make_cpu_context();
+    const std::string& u = ctx.features().device_uuid;
+    ASSERT_EQ(u.size(), 36u) << u;
+    for (size_t i = 0; i < u.size(); ++i) {
+        if (i == 8 || i == 13 || i == 18 || i == 23)
+            EXPECT_EQ(u[i], '-') << u;
+        else
+            EXPECT_TRUE(std::isxdigit(static_cast<unsigned char>(u[i])) &&
+                        !std::isupper(static_cast<unsigned char>(u[i])))
+                << u;
+    }
+    EXPECT_NE(ctx.features().summary().find(u), std::string::npos);
+}
+
+// gpu:N counts GPUs only: beyond the last one (every one, on a machine with lavapipe alone) it is a
+// one-line error naming the devices, never another device.
+TEST(VkContext, GpuIndexBeyondTheGpusIsAClearError) {
+    ContextOptions o;
+    o.set_device("gpu:63");
+    o.validation = false;
+    try {
+        Context ctx(o);
+        ADD_FAILURE() << "gpu:63 picked " << ctx.features().device_name;
+    } catch (const nbvh::Error& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("--device gpu:63"), std::string::npos) << m;
+        EXPECT_NE(m.find("found:"), std::string::npos) << m;
+        EXPECT_EQ(m.find('\n'), std::string::npos) << "one line: " << m;
+    }
 }
 
 TEST(VkBuffer, RoundTripDeviceAndHost) {

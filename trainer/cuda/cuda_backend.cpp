@@ -275,6 +275,13 @@ std::string cuda_device_name() {
 
 bool cuda_backend_available() { return cuda::device_available(nullptr); }
 
+void cuda_use_device_uuid(const std::string& uuid) {
+    if (!cuda::use_device_uuid(uuid))
+        throw Error(
+            "the CUDA runtime has no device with the chosen GPU's UUID " + uuid +
+            " (CUDA_VISIBLE_DEVICES may hide it): train with --backend cpu or choose another --device");
+}
+
 std::unique_ptr<CudaTrainerBackend> make_cuda_backend_ex(const TrainingAsset& asset, const NeuralConfig& config,
                                                          const neural::AdamConfig& adam,
                                                          const CudaBackendOptions& options, uint64_t seed) {

@@ -49,8 +49,12 @@ public:
     virtual float loss_scale() const = 0;
 };
 
-// Name of the CUDA device used (empty when none).
+// Name of the CUDA device used (this thread's current one; empty when none).
 std::string cuda_device_name();
+// Trains on the GPU a Vulkan context chose (`nbvh study --device gpu:N`): makes the CUDA device with this
+// UUID (vk::DeviceFeatures::device_uuid) current on the calling thread. Throws nbvh::Error naming the
+// UUID when no CUDA device has it.
+void cuda_use_device_uuid(const std::string& uuid);
 
 std::unique_ptr<CudaTrainerBackend> make_cuda_backend_ex(const TrainingAsset& asset, const NeuralConfig& config,
                                                          const neural::AdamConfig& adam,

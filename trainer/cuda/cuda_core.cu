@@ -5,6 +5,7 @@
 // loss partials and the per-leaf statistics at its end.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 
@@ -484,11 +485,34 @@ bool device_available(std::string* name) {
         cudaGetLastError(); // clear the sticky "no device" error
         return false;
     }
+    int dev = 0; // this thread's current device (use_device_uuid may have chosen it)
+    if (cudaGetDevice(&dev) != cudaSuccess) return false;
     cudaDeviceProp prop{};
-    if (cudaGetDeviceProperties(&prop, 0) != cudaSuccess) return false;
+    if (cudaGetDeviceProperties(&prop, dev) != cudaSuccess) return false;
     if (prop.major < 7) return false; // tensor-core WMMA fp16 needs sm_70+
     if (name) *name = prop.name;
     return true;
+}
+
+bool use_device_uuid(const std::string& uuid) {
+    int count = 0;
+    if (cudaGetDeviceCount(&count) != cudaSuccess) {
+        cudaGetLastError();
+        return false;
+    }
+    for (int d = 0; d < count; ++d) {
+        cudaDeviceProp prop{};
+        if (cudaGetDeviceProperties(&prop, d) != cudaSuccess) continue;
+        std::string text; // 8-4-4-4-12 hex digits, as vk::DeviceFeatures::device_uuid
+        for (int i = 0; i < 16; ++i) {
+            if (i == 4 || i == 6 || i == 8 || i == 10) text += '-';
+            char hex[3];
+            std::snprintf(hex, sizeof hex, "%02x", unsigned(static_cast<unsigned char>(prop.uuid.bytes[i])));
+            text += hex;
+        }
+        if (text == uuid) return cudaSetDevice(d) == cudaSuccess;
+    }
+    return false;
 }
 
 std::unique_ptr<Core> make_core(const CoreAsset& asset, const CoreConfig& config) {

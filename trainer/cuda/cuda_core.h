@@ -124,7 +124,10 @@ public:
     virtual CoreTimings timings() const = 0;  // of the last step
 };
 
-bool device_available(std::string* name = nullptr);
+bool device_available(std::string* name = nullptr); // this thread's current CUDA device
+// Makes the CUDA device with this UUID (8-4-4-4-12 hex digits, vk::DeviceFeatures::device_uuid) current on
+// the calling thread; false when no CUDA device has it.
+bool use_device_uuid(const std::string& uuid);
 std::unique_ptr<Core> make_core(const CoreAsset& asset, const CoreConfig& config);
 
 } // namespace nbvh::cuda
