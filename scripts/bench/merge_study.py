@@ -19,6 +19,10 @@ def fail(msg):
     sys.exit(f"merge_study.py: {msg}")
 
 
+def without_cap(settings):
+    return {k: v for k, v in (settings or {}).items() if k != "cap_study"}
+
+
 def main(argv):
     if len(argv) < 3:
         fail("usage: merge_study.py OUT.json PART.json [PART.json ...]")
@@ -32,9 +36,12 @@ def main(argv):
             fail(f"{p}: {e}")
     base = parts[0]
     for p, s in zip(paths[1:], parts[1:]):
-        for key in ("scene", "settings", "device", "flip_metric"):
+        for key in ("scene", "device", "flip_metric"):
             if s.get(key) != base.get(key):
                 fail(f"{p}: '{key}' differs from {paths[0]}'s")
+        # The raised-leaf-budget rows run in one part only (study_multi.sh): cap_study may differ.
+        if without_cap(s.get("settings")) != without_cap(base.get("settings")):
+            fail(f"{p}: 'settings' differ from {paths[0]}'s")
         if len(s["cameras"]) != len(base["cameras"]):
             fail(f"{p}: {len(s['cameras'])} cameras, {paths[0]} has {len(base['cameras'])}")
         for a, b in zip(base["cameras"], s["cameras"]):
@@ -43,6 +50,7 @@ def main(argv):
                     fail(f"{p}: camera {a['camera']} '{key}' differs ({b.get(key)} vs {a.get(key)}): "
                          "not the same reference")
     merged = dict(base)
+    merged["settings"] = dict(base["settings"], cap_study=max(s["settings"].get("cap_study", 0) for s in parts))
     merged["configs"], merged["rows"], merged["mean_rows"], merged["parts"], commits = [], [], [], [], []
     offset = 0
     for p, s in zip(paths, parts):

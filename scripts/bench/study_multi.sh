@@ -14,7 +14,7 @@
 #      (default gpu:N) replaces every part's --device: a dry run on the build machine, e.g.
 #      GPUS=2 PART_DEVICE=cpu BACKEND=cpu NBVH=build/app/nbvh PARTS="31:12 63:12" WIDTH=32 HEIGHT=32 SPP=2
 #      REF_SPP=8 TIME_WIDTH=32 TIME_HEIGHT=32 LODS=1 CAMERAS=1 scripts/bench/study_multi.sh default OUT
-#      --steps 20 --batch 256 --threads 1
+#      --steps 20 --batch 256 --threads 1. CAP_AT (default 2395:16): the configuration of the cap rows.
 # The raised-leaf-budget row (--cap-study) runs once, in the part that holds nodes 2395 x hash 2^16 as its
 # middle configuration (as in the one-GPU sweep); the camera-0 PNGs come from the part that ends with
 # the grid's last configuration.
@@ -43,12 +43,13 @@ case "$WHICH" in
 esac
 export NBVH_STUDY_UNPACKED=1 # study.sh: the scene is in $TMP already (parts must not rewrite it)
 
-cap_for() { # NODES HASH: 64 when the part's middle configuration is 2395 x 2^16 (the one-GPU sweep's), else 0
+cap_for() { # NODES HASH: 64 when the part's middle configuration is CAP_AT (default 2395:16, the one-GPU
+  # sweep's middle configuration), else 0
   local -a n h c=()
   IFS=, read -r -a n <<< "$1"
   IFS=, read -r -a h <<< "$2"
   for a in "${n[@]}"; do for b in "${h[@]}"; do c+=("$a:$b"); done; done
-  if [ "${c[$(( ${#c[@]} / 2 ))]}" = "2395:16" ]; then echo 64; else echo 0; fi
+  if [ "${c[$(( ${#c[@]} / 2 ))]}" = "${CAP_AT:-2395:16}" ]; then echo 64; else echo 0; fi
 }
 total_s=$(python3 -c "import sys; print(int(float(sys.argv[1]) * 60))" "${BUDGET:-9.5}")
 read -r -a LIST <<< "$PARTS"
@@ -87,6 +88,6 @@ for i in "${!LIST[@]}"; do
   case ",${part%%:*}," in *,8000,*) ;; *) continue ;; esac
   case ",${part##*:}," in *,18,*) cp "$OUT/part_$i"/*_cam0.png "$OUT"/ 2>/dev/null || true ;; esac
 done
-cat "$OUT"/part_*/log.txt > "$OUT/log.txt"
+cat "$OUT"/part_*/log.txt > "$OUT/log.txt" 2>/dev/null || true
 echo "wrote $OUT/study.json (${#PARTFILES[@]} parts on $GPUS GPU(s)) in $(( $(date +%s) - t0 )) s"
 exit $status

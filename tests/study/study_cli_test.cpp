@@ -272,6 +272,7 @@ TEST(Study, PartsRunInParallelAndMergeIntoOneStudy) {
                                  "BACKEND=cpu",
                                  "NBVH=" + nbvh::test::nbvh_exe().string(),
                                  "PARTS=31:12 63:12",
+                                 "CAP_AT=63:12",
                                  "WIDTH=32",
                                  "HEIGHT=32",
                                  "SPP=2",
@@ -300,13 +301,16 @@ TEST(Study, PartsRunInParallelAndMergeIntoOneStudy) {
     EXPECT_EQ(j.at("configs")[0].at("nodes_target").get<int>(), 31);
     EXPECT_EQ(j.at("configs")[1].at("nodes_target").get<int>(), 63);
     EXPECT_EQ(j.at("parts").size(), 2u);
-    int classical = 0, lod = 0;
+    int classical = 0, lod = 0, cap = 0;
     for (const auto& row : j.at("rows")) {
         if (row.at("variant") == "classical") ++classical;
         if (row.at("variant") == "lod") ++lod;
+        if (row.at("variant") == "cap") ++cap;
     }
     EXPECT_EQ(classical, 2) << "one reference row per camera, not one per part";
     EXPECT_EQ(lod, 4) << "2 configurations x 2 cameras";
+    EXPECT_EQ(cap, 2) << "the raised-leaf-budget rows once: the part whose middle configuration is CAP_AT";
+    EXPECT_EQ(j.at("settings").at("cap_study").get<int>(), 64);
     EXPECT_TRUE(fs::exists(dir / "part_0" / "study.json") && fs::exists(dir / "part_1" / "study.json"));
 }
 
