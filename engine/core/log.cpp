@@ -55,4 +55,13 @@ std::string strfmt(const char* fmt, ...) {
     return out;
 }
 
+std::string format_uuid(const unsigned char* bytes16) {
+    std::string s;
+    for (int i = 0; i < 16; ++i) {
+        if (i == 4 || i == 6 || i == 8 || i == 10) s += '-';
+        s += strfmt("%02x", unsigned(bytes16[i]));
+    }
+    return s;
+}
+
 } // namespace nbvh

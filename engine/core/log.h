@@ -20,4 +20,9 @@ void log_error(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 // printf into a std::string (for building Error messages).
 std::string strfmt(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 
+// A 16-byte UUID as 8-4-4-4-12 lower-case hex digits, the form nvidia-smi prints after "GPU-": Vulkan's
+// deviceUUID and CUDA's cudaDeviceProp::uuid of one GPU give the same text (how `nbvh study --device
+// gpu:N` trains on the GPU it renders on).
+std::string format_uuid(const unsigned char* bytes16);
+
 } // namespace nbvh

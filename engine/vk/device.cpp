@@ -80,7 +80,6 @@ std::optional<std::array<uint32_t, 4>> pci_address(VkPhysicalDevice pd) {
 
 struct Candidate {
     VkPhysicalDevice device;
-    std::string name;
     std::optional<std::array<uint32_t, 4>> pci;
 };
 
@@ -105,15 +104,6 @@ VkPhysicalDevice nth_gpu_in_pci_order(std::vector<Candidate> gpus, int n, const 
     if (!all_pci)
         log_info("--device gpu:%d: a GPU does not report its PCI address; counting in the driver's order", n);
     return gpus[size_t(n)].device;
-}
-
-std::string format_uuid(const uint8_t (&u)[VK_UUID_SIZE]) {
-    std::string s;
-    for (int i = 0; i < int(VK_UUID_SIZE); ++i) {
-        if (i == 4 || i == 6 || i == 8 || i == 10) s += '-';
-        s += strfmt("%02x", unsigned(u[i]));
-    }
-    return s;
 }
 
 } // namespace
@@ -177,7 +167,7 @@ void Context::pick_physical_device(DeviceChoice choice, int gpu_index) {
         if (choice == DeviceChoice::cpu && !cpu) continue;
         if (choice == DeviceChoice::gpu && cpu) continue;
         if (gpu_index >= 0) {
-            gpus.push_back({pd, props.deviceName, pci_address(pd)});
+            gpus.push_back({pd, pci_address(pd)});
             continue;
         }
         int rank = type_rank(props.deviceType);
@@ -233,6 +223,7 @@ void Context::create_device(const std::vector<std::string>& extra_extensions) {
 
     DeviceFeatures& d = features_;
     d.device_name = props.deviceName;
+    static_assert(VK_UUID_SIZE == 16);
     d.device_uuid = format_uuid(p11.deviceUUID);
     d.driver_name = p12.driverName;
     d.driver_info = p12.driverInfo;

@@ -5,13 +5,13 @@
 // loss partials and the per-leaf statistics at its end.
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <memory>
 
+#include "engine/core/log.h"
+#include "engine/neural/shared/adam_update.h"
 #include "trainer/cuda/cuda_core.h"
 #include "trainer/cuda/device_common.cuh"
-#include "engine/neural/shared/adam_update.h"
 
 namespace nbvh::cuda {
 namespace {
@@ -503,14 +503,9 @@ bool use_device_uuid(const std::string& uuid) {
     for (int d = 0; d < count; ++d) {
         cudaDeviceProp prop{};
         if (cudaGetDeviceProperties(&prop, d) != cudaSuccess) continue;
-        std::string text; // 8-4-4-4-12 hex digits, as vk::DeviceFeatures::device_uuid
-        for (int i = 0; i < 16; ++i) {
-            if (i == 4 || i == 6 || i == 8 || i == 10) text += '-';
-            char hex[3];
-            std::snprintf(hex, sizeof hex, "%02x", unsigned(static_cast<unsigned char>(prop.uuid.bytes[i])));
-            text += hex;
-        }
-        if (text == uuid) return cudaSetDevice(d) == cudaSuccess;
+        static_assert(sizeof(prop.uuid.bytes) == 16);
+        if (format_uuid(reinterpret_cast<const unsigned char*>(prop.uuid.bytes)) == uuid)
+            return cudaSetDevice(d) == cudaSuccess;
     }
     return false;
 }
