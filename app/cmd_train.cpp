@@ -19,6 +19,7 @@
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/neural/model_file.h"
+#include "engine/vk/context.h"
 #include "trainer/compact_hash.h"
 #include "trainer/evaluation.h"
 #include "trainer/model_export.h"
@@ -35,6 +36,7 @@ struct TrainArgs {
     std::string asset_glob;
     std::string out;
     std::string backend = "auto";
+    std::string device = "auto"; // auto | gpu | gpu:N (the CUDA device of Vulkan's GPU N)
     std::string log_csv;
     // Unset (not given on the command line) = the backend's default.
     std::optional<uint32_t> nodes, hash_log2, steps, batch, lods;
@@ -53,7 +55,25 @@ bool blended(const TrainingAsset& asset, const TrainingPart& part) {
     return false;
 }
 
+// --device gpu:N: the UUID of the N-th GPU as every other command counts them (Vulkan, PCI bus order,
+// nvidia-smi's numbering), so that CUDA trains on it; empty for auto and gpu (CUDA's first device).
+std::string training_gpu_uuid(const std::string& device) {
+    const vk::DeviceSpec spec = vk::parse_device_spec(device);
+    if (spec.choice == vk::DeviceChoice::cpu)
+        throw Error(
+            "--device cpu: the CPU trainer is --backend cpu (--device picks the GPU: auto, gpu or gpu:N)");
+    if (spec.gpu_index < 0) return {};
+    vk::ContextOptions copt;
+    copt.set_device(device);
+    const vk::Context ctx(copt); // throws the one-line error of a GPU number beyond the last
+    return ctx.features().device_uuid;
+}
+
 void run_train(const TrainArgs& a) {
+    if (vk::parse_device_spec(a.device).gpu_index >= 0 && parse_backend(a.backend) == BackendChoice::cpu)
+        throw Error("--device " + a.device +
+                    " picks the GPU that CUDA trains on; it does not go with --backend cpu");
+    use_cuda_device(training_gpu_uuid(a.device)); // gpu:N; nothing for auto and gpu
     const BackendChoice backend = resolve_backend(parse_backend(a.backend));
     TrainOptions opt = default_train_options(backend);
     if (a.nodes) opt.target_nodes = *a.nodes;
@@ -127,6 +147,9 @@ void add_train_command(CLI::App& app) {
     cmd->add_option("--asset", args->asset_glob, "train only the neural assets whose name matches this glob");
     cmd->add_option("--out,-o", args->out, "output model (default: SCENE.nbvh in the current directory)");
     cmd->add_option("--backend", args->backend, "cpu, cuda or auto (default: auto = cuda when a GPU is usable)");
+    cmd->add_option("--device", args->device,
+                    "GPU that CUDA trains on: auto or gpu (CUDA's first device), gpu:N (the N-th GPU in PCI "
+                    "order, nvidia-smi's number, as --device of render, view and study)");
     cmd->add_option("--nodes", args->nodes, "target N-BVH node count (CPU default 1000, CUDA 2395)");
     cmd->add_option("--hash-log2", args->hash_log2, "log2 of the hash-table entries per level (default: compact, the largest up to CPU 15 / CUDA 18 whose grid is at most 1/5 of the replaced mesh + BLAS)");
     cmd->add_option("--steps", args->steps, "optimiser steps (CPU default 1000, CUDA 10000)");

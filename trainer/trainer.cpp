@@ -7,6 +7,9 @@
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
+#if defined(NBVH_HAVE_CUDA)
+#include "trainer/cuda/cuda_backend.h"
+#endif
 
 namespace nbvh {
 
@@ -93,6 +96,16 @@ BackendChoice resolve_backend(BackendChoice choice) {
     if (cuda_backend_available()) return BackendChoice::cuda;
 #endif
     return BackendChoice::cpu;
+}
+
+void use_cuda_device(const std::string& uuid) {
+    if (uuid.empty()) return;
+#if defined(NBVH_HAVE_CUDA)
+    cuda_use_device_uuid(uuid);
+#else
+    throw Error("training on GPU " + uuid +
+                " needs the CUDA backend, which this build has not (use --backend cpu)");
+#endif
 }
 
 std::unique_ptr<TrainerBackend> make_backend(BackendChoice choice, const TrainingAsset& asset,

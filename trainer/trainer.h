@@ -84,6 +84,12 @@ struct TrainResult {
 
 // Resolves `automatic` (CUDA when this build has it and a GPU is usable, else CPU).
 BackendChoice resolve_backend(BackendChoice choice);
+// The CUDA device that this host thread's CUDA training runs on: the one whose UUID is `uuid`, in the
+// form of DeviceFeatures::device_uuid (the Vulkan GPU a user picked with --device gpu:N, so training and
+// rendering share one GPU on a host with several). CUDA's current device is per thread: call it in the
+// thread that trains, before make_backend. Empty: leave the choice to CUDA (its first device, or
+// CUDA_VISIBLE_DEVICES). Throws nbvh::Error when no CUDA device has that UUID or the build has no CUDA.
+void use_cuda_device(const std::string& uuid);
 // The backend for `options` (network init from options.seed, Adam from make_adam_config). Throws
 // nbvh::Error when CUDA is asked for and not available.
 std::unique_ptr<TrainerBackend> make_backend(BackendChoice choice, const TrainingAsset& asset,

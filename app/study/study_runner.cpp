@@ -185,10 +185,9 @@ void StudyRun::run() {
     vk::ContextOptions copt;
     copt.set_device(o_.device);
     ctx_ = std::make_unique<vk::Context>(copt);
-#if defined(NBVH_HAVE_CUDA)
     // --device gpu:N: train on the GPU that renders (matched by UUID), not on CUDA's first device.
-    if (backend_ == BackendChoice::cuda && copt.gpu_index >= 0)
-        cuda_use_device_uuid(ctx_->features().device_uuid);
+    if (backend_ == BackendChoice::cuda && copt.gpu_index >= 0) use_cuda_device(ctx_->features().device_uuid);
+#if defined(NBVH_HAVE_CUDA)
     if (backend_ == BackendChoice::cuda) train_device_ = cuda_device_name();
 #endif
     if (train_device_.empty())

@@ -135,9 +135,10 @@ void LiveTrainer::start(const Scene& scene, const std::string& source, const Tra
         history_stride_ = 1;
     }
     active_ = true;
-    worker_ = std::thread([this, copy, source, opt, backend, every] {
+    worker_ = std::thread([this, copy, source, opt, backend, every, uuid = cuda_uuid_] {
         std::string end = "done";
         try {
+            if (backend == BackendChoice::cuda) use_cuda_device(uuid); // CUDA's device is per thread
             split_neural_meshes(*copy);
             const std::vector<uint32_t> meshes = neural_meshes(*copy);
             const TrainingAsset asset = make_training_asset(*copy, meshes);

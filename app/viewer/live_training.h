@@ -55,6 +55,9 @@ public:
     // Trains the neural assets of a copy of `scene` (`source` names it in the model). Throws nbvh::Error
     // for bad options, a scene without neural instances, or while a run is active.
     void start(const Scene& scene, const std::string& source, const TrainSettings& settings);
+    // The CUDA device of later runs (trainer.h use_cuda_device: the viewer's GPU of --device gpu:N);
+    // empty: CUDA's first.
+    void set_cuda_device(std::string uuid) { cuda_uuid_ = std::move(uuid); }
     void set_paused(bool paused);
     void stop();          // asks the worker to stop after its current step and waits for it
     bool active() const;  // the worker runs (training or paused)
@@ -83,6 +86,7 @@ private:
     std::shared_ptr<const std::vector<float>> latest_loss_;
     bool taken_ = true;
     uint32_t history_stride_ = 1;
+    std::string cuda_uuid_;
 };
 
 } // namespace nbvh::viewer

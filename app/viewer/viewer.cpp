@@ -52,6 +52,7 @@ void run_viewer(const ViewerArgs& a) {
         s.show_ui = !a.hide_ui;
         ViewerSession session(ctx, std::move(view), so, s, width, height);
         session.set_script(std::move(script));
+        if (copt.gpu_index >= 0) session.train_on_gpu(ctx.features().device_uuid); // train where it renders
         Screenshot shot;
         uint32_t frame = 0;
         bool last = false;

@@ -49,6 +49,8 @@ public:
     const ViewSettings& settings() const { return settings_; }
     const ViewRenderers& renderers() const { return renderers_; }
     void set_script(ScriptRunner script) { script_ = std::move(script); }
+    // Live training's CUDA device (LiveTrainer::set_cuda_device): the view's GPU under --device gpu:N.
+    void train_on_gpu(std::string uuid) { trainer_.set_cuda_device(std::move(uuid)); }
     nlohmann::json report() const;
 
 private:

@@ -58,13 +58,16 @@ DeviceChoice parse_device_choice(std::string_view text) {
 
 DeviceSpec parse_device_spec(std::string_view text) {
     constexpr std::string_view prefix = "gpu:";
-    if (text.substr(0, prefix.size()) != prefix) return {parse_device_choice(text), -1};
-    const std::string_view digits = text.substr(prefix.size());
-    const bool ok = !digits.empty() && digits.size() <= 4 &&
-                    std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; });
+    const bool indexed = text.substr(0, prefix.size()) == prefix;
+    const std::string_view digits = indexed ? text.substr(prefix.size()) : std::string_view();
+    const bool ok =
+        indexed ? !digits.empty() && digits.size() <= 4 &&
+                      std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })
+                : text == "auto" || text == "gpu" || text == "cpu";
     if (!ok)
         throw Error("unknown --device '" + std::string(text) +
                     "' (expected auto, gpu, gpu:N with N the GPU's number from 0, or cpu)");
+    if (!indexed) return {parse_device_choice(text), -1};
     return {DeviceChoice::gpu, std::stoi(std::string(digits))};
 }
 

@@ -216,6 +216,25 @@ TEST(CliTrain, OptionsOutOfRange) {
     EXPECT_FALSE(fs::exists(dir / "m.nbvh"));
 }
 
+// --device picks the GPU that CUDA trains on, numbered as every other command's --device (Vulkan, PCI
+// order); each misuse is a one-line error before any training.
+TEST(CliTrain, DeviceIsTheGpuThatCudaTrainsOn) {
+    const fs::path dir = nbvh::test::temp_dir("cli_train_device");
+    std::vector<std::string> a = tiny_train("default", dir / "m.nbvh");
+    a.insert(a.end(), {"--device", "cpu"});
+    EXPECT_CLEAN_ERROR(run_nbvh(a, 20.0), "--backend cpu");
+    a.back() = "gpu:x";
+    EXPECT_CLEAN_ERROR(run_nbvh(a, 20.0), "gpu:N");
+    a.back() = "gpu:0"; // tiny_train's --backend cpu: the two contradict each other
+    EXPECT_CLEAN_ERROR(run_nbvh(a, 20.0), "--backend cpu");
+    // Beyond the machine's GPUs (on CI: any N, lavapipe is no GPU), with the backend left to choose.
+    a = {"train",    "default", "--steps", "2",     "--batch",
+         "64",       "--nodes", "8",       "--out", (dir / "m.nbvh").string(),
+         "--device", "gpu:63"};
+    EXPECT_CLEAN_ERROR(run_nbvh(a, 20.0), "--device gpu:63");
+    EXPECT_FALSE(fs::exists(dir / "m.nbvh"));
+}
+
 TEST(CliTrain, SceneWithoutNeuralAssetAndGlobMatchingNothing) {
     NBVH_REQUIRE_SHARED();
     const fs::path dir = nbvh::test::temp_dir("cli_train_neural");

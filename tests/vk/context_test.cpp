@@ -87,6 +87,11 @@ TEST(VkContext, DeviceSpecParsing) {
     for (const char* bad :
          {"gpu:", "gpu:-1", "gpu:x", "gpu:1x", "gpu: 1", "gpu:99999", "cpu:0", "gpu0", "GPU:1"})
         EXPECT_THROW(parse_device_spec(bad), nbvh::Error) << bad;
+    try { // every unknown word is told every form, gpu:N included
+        parse_device_spec("gpu0");
+    } catch (const nbvh::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("gpu:N"), std::string::npos) << e.what();
+    }
     ContextOptions o;
     o.set_device("gpu:3");
     EXPECT_EQ(o.device, DeviceChoice::gpu);
