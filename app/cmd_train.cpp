@@ -25,6 +25,9 @@
 #include "trainer/model_export.h"
 #include "trainer/progress_bar.h"
 #include "trainer/trainer.h"
+#if defined(NBVH_HAVE_CUDA)
+#include "trainer/cuda/cuda_backend.h"
+#endif
 
 namespace nbvh::app {
 
@@ -104,9 +107,14 @@ void run_train(const TrainArgs& a) {
     }
     std::unique_ptr<TrainerBackend> be = make_backend(backend, asset, opt);
     const SplitSchedule schedule = make_split_schedule(opt);
-    log_info("training %s (%u triangles) on %s: %u steps x %u rays, target %u nodes, hash 2^%u, %u LoD(s); %s",
-             asset.name.c_str(), asset.triangle_count(), backend == BackendChoice::cuda ? "cuda" : "cpu", opt.steps,
-             opt.batch_size, opt.target_nodes, opt.network.log2_hash_size, opt.lods, describe(schedule).c_str());
+    std::string on = backend == BackendChoice::cuda ? "cuda" : "cpu";
+#if defined(NBVH_HAVE_CUDA)
+    if (backend == BackendChoice::cuda) on += " (" + cuda_device_name() + ")"; // the GPU --device picked
+#endif
+    log_info(
+        "training %s (%u triangles) on %s: %u steps x %u rays, target %u nodes, hash 2^%u, %u LoD(s); %s",
+        asset.name.c_str(), asset.triangle_count(), on.c_str(), opt.steps, opt.batch_size, opt.target_nodes,
+        opt.network.log2_hash_size, opt.lods, describe(schedule).c_str());
 
     ProgressBar bar;
     TrainResult result = train_asset(asset, opt, *be, [&](const TrainProgress& p) { bar.update(p); });
