@@ -79,6 +79,20 @@ void add_study_command(CLI::App& app, const std::string& command_line) {
            "--budget-minutes", o->budget_minutes,
            "start no configuration that would end after this many minutes (the rest is reported as not run)")
         ->check(CLI::Range(0.0, 1.0e6));
+    cmd->add_option("--references", o->references_dir,
+                    "folder that keeps each camera's classical side (reference, noise floor, frame time, "
+                    "equal-time FLIPs): taken from it when a study of the same setup made it, else written");
+    cmd->add_flag("--references-only", o->references_only,
+                  "render the cameras' classical side into --references and stop (no training)");
+    cmd->add_option("--reference-cameras", o->reference_cameras,
+                    "with --references-only: these cameras only, comma-separated (one GPU each: "
+                    "scripts/bench/study_multi.sh)")
+        ->delimiter(',')
+        ->check(CLI::Range(0u, 15u));
+    cmd->add_option("--equal-time-upto", o->equal_time_upto,
+                    "extend each camera's classical film to this x --spp up front (equal-time FLIPs of "
+                    "hybrids up to this x the classical frame, kept with --references; 0: as rows ask)")
+        ->check(CLI::Range(0.0, 64.0));
     cmd->add_flag("--save-images", o->save_images,
                   "also write camera 0's reference, hybrid and decimated PNGs");
     cmd->callback([o] {

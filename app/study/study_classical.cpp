@@ -17,6 +17,7 @@
 #include "app/render_measure.h"
 #include "app/study/study_cameras.h"
 #include "app/study/study_progress.h"
+#include "app/study/study_references.h"
 #include "app/study/study_rows.h"
 #include "app/training_scene.h"
 #include "engine/bvh/scene_accel.h"
@@ -70,36 +71,57 @@ double StudyRun::time_frame(WavefrontRenderer& image_renderer, WavefrontRenderer
 
 void StudyRun::classical_side() {
     const Scene& scene = ts_.scene;
-    for (size_t c = 0; c < cams_.size(); ++c) {
-        CameraSide& cam = cams_[c];
-        progress_.begin(StudyTask::render,
-                        pixel_samples(o_.ref_spp) + pixel_samples(o_.render.spp) + timing_work(),
-                        strfmt("camera %zu: classical reference (%u spp), noise floor (%u spp)", c,
-                               o_.ref_spp, o_.render.spp));
+    for (CameraSide& cam : cams_) {
+        const size_t c = cam.index;
         RenderOptions ref = image_options(o_.ref_spp, o_.render.seed + STUDY_REFERENCE_SEED_OFFSET);
         ref.neural.classical = true;
         render::validate(ref.neural, scene);
+        // The image-size classical renderer: the reference and the floor, then the equal-time renders
+        // (also of a camera whose side --references held: those not kept there are rendered anew).
         cam.classical = std::make_unique<WavefrontRenderer>(*ctx_, scene, accel_, env_, cam.camera, ref);
-        render::RenderResult r = cam.classical->render();
-        device_ = r.stats.device, driver_ = r.stats.driver;
-        cam.exposure = fixed_exposure_ ? *fixed_exposure_ : auto_exposure(r.image).stops;
-        const Image ref_px = as_png_pixels(r.image, cam.exposure);
-        if (o_.save_images && c == 0) save("reference_cam0.png", r.image, cam.exposure);
-        RenderOptions same = image_options(o_.render.spp, o_.render.seed);
-        same.neural.classical = true;
-        const Image floor_px = as_png_pixels(render_with(*cam.classical, same).image, cam.exposure);
-        cam.film_spp = o_.render.spp;
-        cam.ref_flip.emplace(ref_px);
-        cam.floor_flip.emplace(floor_px);
-        cam.noise_floor = cam.ref_flip->compare(floor_px).mean;
-        std::unique_ptr<WavefrontRenderer> timing;
-        if (separate_timing()) {
-            RenderOptions t = timing_options();
-            t.neural.classical = true;
-            timing = std::make_unique<WavefrontRenderer>(*ctx_, scene, accel_, env_, cam.camera, t);
+        if (cam.cached) {
+            if (o_.save_images && c == 0) // the pixels are the PNG's: written as they are
+                save_png((fs::path(o_.out_dir) / "reference_cam0.png").string(), cam.reference_px);
+            progress_.note(strfmt(
+                "camera %zu: classical side from --references %s: noise floor %.4f, classical "
+                "%.3f ms/frame, %zu equal-time FLIPs",
+                c, o_.references_dir.c_str(), cam.noise_floor, cam.classical_ms, cam.equal_time_flip.size()));
+        } else {
+            progress_.begin(StudyTask::render,
+                            pixel_samples(o_.ref_spp) + pixel_samples(o_.render.spp) + timing_work(),
+                            strfmt("camera %zu: classical reference (%u spp), noise floor (%u spp)", c,
+                                   o_.ref_spp, o_.render.spp));
+            render::RenderResult r = cam.classical->render();
+            cam.exposure = fixed_exposure_ ? *fixed_exposure_ : auto_exposure(r.image).stops;
+            const Image ref_px = as_png_pixels(r.image, cam.exposure);
+            if (o_.save_images && c == 0) save("reference_cam0.png", r.image, cam.exposure);
+            RenderOptions same = image_options(o_.render.spp, o_.render.seed);
+            same.neural.classical = true;
+            const Image floor_px = as_png_pixels(render_with(*cam.classical, same).image, cam.exposure);
+            cam.film_spp = o_.render.spp;
+            cam.ref_flip.emplace(ref_px);
+            cam.floor_flip.emplace(floor_px);
+            cam.noise_floor = cam.ref_flip->compare(floor_px).mean;
+            std::unique_ptr<WavefrontRenderer> timing;
+            if (separate_timing()) {
+                RenderOptions t = timing_options();
+                t.neural.classical = true;
+                timing = std::make_unique<WavefrontRenderer>(*ctx_, scene, accel_, env_, cam.camera, t);
+            }
+            cam.classical_ms = time_frame(*cam.classical, timing.get(), same);
+            cam.equal_time_flip[o_.render.spp] = cam.noise_floor;
+            if (!o_.references_dir.empty()) { // kept at once: a later failure loses no render
+                cam.reference_px = ref_px, cam.floor_px = floor_px;
+                save_reference(o_.references_dir, c, reference_key(cam), cached_of(cam));
+                cam.kept_equal_time = cam.equal_time_flip.size();
+            }
+            progress_.end(strfmt("noise floor %.4f, classical %.3f ms/frame (%u spp), exposure %+.2f stops",
+                                 cam.noise_floor, cam.classical_ms, o_.time_spp, cam.exposure));
         }
-        cam.classical_ms = time_frame(*cam.classical, timing.get(), same);
-        cam.equal_time_flip[o_.render.spp] = cam.noise_floor;
+        if (o_.equal_time_upto > 0.0 && !cam.cached) { // equal-time FLIPs up front (kept with the references)
+            uint32_t spp = 0;
+            equal_time(cam, o_.equal_time_upto, &spp);
+        }
 
         StudyRow row;
         row.variant = "classical";
@@ -115,8 +137,89 @@ void StudyRun::classical_side() {
         row.equal_time_spp = o_.render.spp;
         row.equal_time_flip = cam.noise_floor;
         rows_.push_back(row);
-        progress_.end(strfmt("noise floor %.4f, classical %.3f ms/frame (%u spp), exposure %+.2f stops",
-                             cam.noise_floor, cam.classical_ms, o_.time_spp, cam.exposure));
+    }
+    keep_references();
+}
+
+// The camera's film holds the floor render's samples (the compared seed, `spp`) again, so the equal-time
+// renders extend it: every equal-time FLIP comes from the same sums, whether the film was left by the floor
+// render or by the timed frames, or the camera's side came from --references.
+void StudyRun::start_film(CameraSide& cam) {
+    RenderOptions same = image_options(o_.render.spp, o_.render.seed);
+    same.neural.classical = true;
+    render_with(*cam.classical, same);
+    cam.film_spp = o_.render.spp;
+}
+
+nlohmann::json StudyRun::reference_key(const CameraSide& cam) const {
+    const RenderOptions t = timing_options();
+    const vk::DeviceFeatures& f = ctx_->features();
+    return {{"commit", o_.commit},
+            {"device", f.device_name},
+            {"driver", f.driver_name + " " + f.driver_info},
+            {"scene", o_.scene},
+            {"scene_hash", strfmt("%016llx", (unsigned long long)ts_.source_hash)},
+            {"neural", o_.neural_glob},
+            {"camera", camera_string(cam.camera)},
+            {"env", o_.env},
+            {"env_rotation", o_.env_rotation ? *o_.env_rotation : 0.0f},
+            {"width", o_.render.width},
+            {"height", o_.render.height},
+            {"spp", o_.render.spp},
+            {"ref_spp", o_.ref_spp},
+            {"seed", o_.render.seed},
+            {"max_depth", o_.render.max_depth},
+            {"rr_start_depth", o_.render.rr_start_depth},
+            {"sampler", render::sampler_name(o_.render.sampler)},
+            {"texture_path", int(o_.render.texture_path)},
+            {"sort_rays", o_.render.sort_rays},
+            {"max_wave_pixels", o_.render.max_wave_pixels},
+            {"exposure", o_.exposure},
+            {"time_spp", o_.time_spp},
+            {"time_width", t.width},
+            {"time_height", t.height},
+            {"repeat", o_.repeat}};
+}
+
+CachedCamera StudyRun::cached_of(const CameraSide& cam) const {
+    CachedCamera k;
+    k.exposure = cam.exposure;
+    k.noise_floor = cam.noise_floor;
+    k.classical_ms = cam.classical_ms;
+    k.equal_time_flip = cam.equal_time_flip;
+    k.reference_px = cam.reference_px;
+    k.floor_px = cam.floor_px;
+    return k;
+}
+
+void StudyRun::load_references() {
+    if (o_.references_dir.empty()) return;
+    for (CameraSide& cam : cams_) {
+        std::optional<CachedCamera> k = load_reference(o_.references_dir, cam.index, reference_key(cam));
+        if (!k) continue;
+        if (k->reference_px.width != int(o_.render.width) || k->reference_px.height != int(o_.render.height))
+            throw Error(strfmt("--references %s: camera %zu's images are not %ux%u",
+                               o_.references_dir.c_str(), cam.index, o_.render.width, o_.render.height));
+        cam.cached = true;
+        cam.exposure = k->exposure;
+        cam.noise_floor = k->noise_floor;
+        cam.classical_ms = k->classical_ms;
+        cam.equal_time_flip = std::move(k->equal_time_flip);
+        cam.ref_flip.emplace(k->reference_px);
+        cam.floor_flip.emplace(k->floor_px);
+        cam.reference_px = std::move(k->reference_px);
+        cam.floor_px = std::move(k->floor_px);
+        cam.film_spp = 0; // the film holds nothing of the compared seed: an equal-time miss renders anew
+        cam.kept_equal_time = cam.equal_time_flip.size();
+    }
+}
+
+void StudyRun::keep_references() {
+    if (o_.references_dir.empty()) return;
+    for (CameraSide& cam : cams_) {
+        if (!cam.ref_flip || cam.equal_time_flip.size() == cam.kept_equal_time) continue; // nothing new
+        save_reference(o_.references_dir, cam.index, reference_key(cam), cached_of(cam));
+        cam.kept_equal_time = cam.equal_time_flip.size();
     }
 }
 
@@ -134,6 +237,8 @@ double StudyRun::equal_time(CameraSide& cam, double ratio, uint32_t* spp_out) {
     *spp_out = spp;
     if (auto it = cam.equal_time_flip.find(spp); it != cam.equal_time_flip.end()) return it->second;
     auto flip_of = [&](const Image& linear) { return cam.ref_flip->compare(as_png_pixels(linear, cam.exposure)).mean; };
+    if (spp > base && (cam.film_spp == 0 || cam.classical->accumulated_samples() != cam.film_spp))
+        start_film(cam); // the floor's samples again, extended below as in the run that made the reference
     const bool extend = cam.film_spp > 0 && cam.film_spp < spp && cam.classical->accumulated_samples() == cam.film_spp;
     if (!extend) {
         RenderOptions opt = image_options(spp, o_.render.seed);

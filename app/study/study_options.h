@@ -42,6 +42,14 @@ struct StudyOptions {
     bool decimation = true;  // equal-memory meshoptimizer baseline rows
     bool equal_time = true;  // classical at the spp that fits the hybrid's frame time
     bool save_images = false;
+    // The classical side of every camera (reference, noise floor, frame time, equal-time FLIPs) kept in
+    // this folder and taken from it when a study of the same setup made it (study_references.h).
+    std::string references_dir;
+    bool references_only = false;            // write the cameras' classical side there and stop (no sweep)
+    std::vector<uint32_t> reference_cameras; // with references_only: these cameras only (default: all)
+    // Extend each camera's classical film to this x spp up front, so equal-time FLIPs of hybrids up to
+    // this x the classical frame time are kept with the references (0: as the rows ask for them).
+    double equal_time_upto = 0.0;
     double budget_minutes = 0.0; // > 0: start no configuration that would end past this (wall time) //
                                  // reference / hybrid / decimated PNGs of camera 0 (first config)
 

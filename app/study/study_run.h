@@ -14,6 +14,7 @@
 
 #include "app/study/study_options.h"
 #include "app/study/study_progress.h"
+#include "app/study/study_references.h"
 #include "app/study/study_rows.h"
 #include "app/training_scene.h"
 #include "engine/bvh/scene_accel.h"
@@ -35,6 +36,8 @@ struct Config {
 // Everything of one camera that every configuration compares against.
 struct CameraSide {
     Camera camera;
+    size_t index = 0;       // the camera's number in the study (file names of --references, result rows)
+    bool cached = false;    // its classical side came from --references
     float exposure = 0.0f;  // stops of every PNG of this camera (the reference's auto exposure)
     // The reference (ref_spp) and the classical image (spp, compared seed) as PNG pixels, prepared once
     // for the FLIPs of every row (FlipReference: the same figures as flip_ldr, half the filtering).
@@ -45,6 +48,8 @@ struct CameraSide {
     // Samples of the compared seed in `classical`'s film (the floor render, then equal-time extensions);
     // 0 when the film holds something else.
     uint32_t film_spp = 0;
+    Image reference_px, floor_px; // kept for --references (empty without it)
+    size_t kept_equal_time = 0;   // equal-time FLIPs in --references as last written or read
 };
 
 class StudyRun {
@@ -104,9 +109,14 @@ class StudyRun {
                       RenderOptions opt);
     void plan();
     void classical_side();
+    nlohmann::json reference_key(const CameraSide& cam) const; // what makes a camera's classical side
+    void load_references(); // the cameras --references holds (before plan(): theirs is no work)
+    void keep_references(); // every camera's classical side into --references (equal-time FLIPs grown)
+    CachedCamera cached_of(const CameraSide& cam) const;
     void run_config(size_t index, const Config& c);
     TrainOptions train_options(const Config& c) const; // validated (throws nbvh::Error)
     double equal_time(CameraSide& cam, double ratio, uint32_t* spp_out);
+    void start_film(CameraSide& cam);
     void write_results() const;
 
     const StudyOptions& o_;

@@ -57,10 +57,10 @@ std::string utc_now() {
 
 void StudyRun::plan() {
     const double cams = double(cams_.size());
-    for (size_t c = 0; c < cams_.size(); ++c) {
-        progress_.plan(StudyTask::render,
-                       pixel_samples(o_.ref_spp) + pixel_samples(o_.render.spp) + timing_work());
-    }
+    for (const CameraSide& cam : cams_)
+        if (!cam.cached)
+            progress_.plan(StudyTask::render,
+                           pixel_samples(o_.ref_spp) + pixel_samples(o_.render.spp) + timing_work());
     const TrainOptions d = default_train_options(backend_);
     const double samples = double(o_.steps.value_or(d.steps)) * o_.batch.value_or(d.batch_size);
     for (size_t i = 0; i < configs_.size(); ++i) {
@@ -81,7 +81,8 @@ void StudyRun::write_results() const {
     write_text_atomically((fs::path(o_.out_dir) / "study.csv").string(), study_csv(all, o_.scene));
     nlohmann::json cams = nlohmann::json::array();
     for (size_t c = 0; c < cams_.size(); ++c)
-        cams.push_back({{"camera", c},
+        cams.push_back({{"camera", cams_[c].index},
+                        {"from_references", cams_[c].cached},
                         {"view", camera_string(cams_[c].camera)},
                         {"exposure_stops", cams_[c].exposure},
                         {"noise_floor", cams_[c].noise_floor},
@@ -129,6 +130,8 @@ void StudyRun::write_results() const {
           {"neural_kernel", kernel_},
           {"lods", o_.lods},
           {"exposure", o_.exposure},
+          {"references", o_.references_dir},
+          {"equal_time_upto", o_.equal_time_upto},
           {"neural_scratch_bytes_per_ray",
            render::neural_scratch_bytes_per_ray(o_.render.neural.leaves_per_round)}}},
         {"flip_metric",
@@ -155,6 +158,14 @@ void StudyRun::run() {
         throw Error("--ref-spp must be at least --spp (the reference must be converged)");
     if ((o_.time_width == 0) != (o_.time_height == 0))
         throw Error("--time-width and --time-height go together");
+    if (o_.references_only && o_.references_dir.empty())
+        throw Error("--references-only needs --references DIR (the folder it writes)");
+    if (!o_.reference_cameras.empty() && !o_.references_only)
+        throw Error("--reference-cameras goes with --references-only (a sweep compares every camera)");
+    for (uint32_t c : o_.reference_cameras)
+        if (c >= o_.camera_count)
+            throw Error(strfmt("--reference-cameras %u: the study has cameras 0 to %u (--cameras)", c,
+                               o_.camera_count - 1));
     time_width_ = o_.time_width;
     time_height_ = o_.time_height;
     neural_path_ = render::parse_neural_path(o_.neural_path);
@@ -165,9 +176,12 @@ void StudyRun::run() {
     env_ = choose_environment(ts_.scene, o_.env);
     if (o_.env_rotation) env_.rotation = *o_.env_rotation * 3.14159265358979f / 180.0f;
     cams_.resize(0);
-    for (const Camera& c : study_cameras(ts_.scene, o_.cameras, o_.camera_count,
-                                         float(o_.render.width) / float(o_.render.height)))
-        cams_.push_back(CameraSide{c});
+    const std::vector<Camera> cameras = study_cameras(ts_.scene, o_.cameras, o_.camera_count,
+                                                      float(o_.render.width) / float(o_.render.height));
+    const auto& only = o_.reference_cameras;
+    for (size_t i = 0; i < cameras.size(); ++i)
+        if (only.empty() || std::find(only.begin(), only.end(), uint32_t(i)) != only.end())
+            cams_.push_back(CameraSide{cameras[i], i});
     fs::create_directories(o_.out_dir);
 
     asset_ = std::make_unique<TrainingAsset>(make_training_asset(ts_.scene, ts_.meshes));
@@ -185,6 +199,8 @@ void StudyRun::run() {
     vk::ContextOptions copt;
     copt.set_device(o_.device);
     ctx_ = std::make_unique<vk::Context>(copt);
+    device_ = ctx_->features().device_name;
+    driver_ = ctx_->features().driver_name + " " + ctx_->features().driver_info;
     // --device gpu:N: train on the GPU that renders (matched by UUID), not on CUDA's first device.
     if (backend_ == BackendChoice::cuda && copt.gpu_index >= 0) use_cuda_device(ctx_->features().device_uuid);
 #if defined(NBVH_HAVE_CUDA)
@@ -203,6 +219,8 @@ void StudyRun::run() {
     // ~3 GB classical, ~9 GB hybrid each). Timed frames keep a lone renderer's share.
     image_memory_share_ = std::min(o_.render.wave_memory_share, 0.5f / float(cams_.size() + 2));
     accel_ = build_scene_accel(ts_.scene);
+    if (o_.references_only) configs_.clear(); // the classical side alone
+    load_references();
     const size_t variants = variants_of(0, o_.lods).size();
     plan();
     progress_.note(
@@ -234,6 +252,7 @@ void StudyRun::run() {
             configs_done_ = i + 1;
             write_results();
         }
+        keep_references(); // with the equal-time FLIPs the rows added
         write_results();
     } catch (...) {
         set_log_level(level);

@@ -4,7 +4,10 @@
 # the same GPU), the GPUs run in parallel (a GPU with two parts runs them one after the other), and
 # `merge_study.py` joins the parts into OUT/study.json. Every part renders the same references and noise
 # floors (same seeds; the merge refuses parts whose floors differ), so the merged study is the one-GPU
-# sweep's, in less time.
+# sweep's, in less time. With REFS=1 (default) the cameras' classical side (reference, floor, frame time,
+# equal-time FLIPs up to EQUAL_TIME_UPTO x SPP, default 3) is rendered first, one camera per GPU in
+# parallel (`nbvh study --references-only --reference-cameras C`), into OUT/references, and every part
+# takes it from there (`--references`): the parts render no classical image, so a high-spp sweep fits.
 # Usage (GPU machine, after `source .device/env.sh`): scripts/bench/study_multi.sh default|dragon|chess OUT
 #   [extra nbvh study flags]
 # Env: GPUS (default: the GPUs nvidia-smi lists), PARTS (default for the 3 x 3 sweep below: balanced for
@@ -52,10 +55,28 @@ cap_for() { # NODES HASH: 64 when the part's middle configuration is CAP_AT (def
   if [ "${c[$(( ${#c[@]} / 2 ))]}" = "${CAP_AT:-2395:16}" ]; then echo 64; else echo 0; fi
 }
 total_s=$(python3 -c "import sys; print(int(float(sys.argv[1]) * 60))" "${BUDGET:-9.5}")
+t_start=$(date +%s)
+REFARGS=()
+if [ "${REFS:-1}" = 1 ]; then
+  REFARGS=(--references "$OUT/references")
+  pids=()
+  for c in $(seq 0 $(( ${CAMERAS:-3} - 1 ))); do
+    g=$(( c % GPUS ))
+    dev=${PART_DEVICE:-gpu:$g}
+    echo "camera $c: classical side on $dev"
+    DEVICE=$dev scripts/bench/study.sh "$WHICH" "$OUT/references_cam$c" "${REFARGS[@]}" --references-only \
+      --reference-cameras "$c" --equal-time-upto "${EQUAL_TIME_UPTO:-3}" "$@" > "$OUT/references_cam$c.out" 2>&1 &
+    pids+=($!)
+    if [ $(( (c + 1) % GPUS )) = 0 ]; then for p in "${pids[@]}"; do wait "$p" || status_refs=1; done; pids=(); fi
+  done
+  for p in "${pids[@]}"; do wait "$p" || status_refs=1; done
+  [ "${status_refs:-0}" = 0 ] || { echo "study_multi.sh: a camera's classical side failed: $OUT/references_cam*.out" >&2; exit 1; }
+  echo "classical sides of ${CAMERAS:-3} camera(s) in $(( $(date +%s) - t_start )) s"
+fi
 read -r -a LIST <<< "$PARTS"
 declare -a QUEUE # per GPU: the part indices it runs, in order
 for i in "${!LIST[@]}"; do QUEUE[$((i % GPUS))]+="$i "; done
-t0=$(date +%s)
+t0=$t_start # the budget counts the classical sides too
 pids=()
 for g in $(seq 0 $((GPUS - 1))); do
   (
@@ -68,7 +89,7 @@ for g in $(seq 0 $((GPUS - 1))); do
       dev=${PART_DEVICE:-gpu:$g}
       echo "part $i ($nodes x $hash) on $dev, cap-study $cap, budget $left min"
       DEVICE=$dev NODES=$nodes HASH=$hash BUDGET=$left scripts/bench/study.sh "$WHICH" "$OUT/part_$i" \
-        --cap-study "$cap" "$@" > "$OUT/part_$i.out" 2>&1 || { echo "part $i failed: $OUT/part_$i.out" >&2; exit 1; }
+        --cap-study "$cap" "${REFARGS[@]}" "$@" > "$OUT/part_$i.out" 2>&1 || { echo "part $i failed: $OUT/part_$i.out" >&2; exit 1; }
     done
   ) &
   pids+=($!)
@@ -88,6 +109,6 @@ for i in "${!LIST[@]}"; do
   case ",${part%%:*}," in *,8000,*) ;; *) continue ;; esac
   case ",${part##*:}," in *,18,*) cp "$OUT/part_$i"/*_cam0.png "$OUT"/ 2>/dev/null || true ;; esac
 done
-cat "$OUT"/part_*/log.txt > "$OUT/log.txt" 2>/dev/null || true
+cat "$OUT"/references_cam*/log.txt "$OUT"/part_*/log.txt > "$OUT/log.txt" 2>/dev/null || true
 echo "wrote $OUT/study.json (${#PARTFILES[@]} parts on $GPUS GPU(s)) in $(( $(date +%s) - t0 )) s"
 exit $status

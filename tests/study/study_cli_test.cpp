@@ -312,6 +312,74 @@ TEST(Study, PartsRunInParallelAndMergeIntoOneStudy) {
     EXPECT_EQ(cap, 2) << "the raised-leaf-budget rows once: the part whose middle configuration is CAP_AT";
     EXPECT_EQ(j.at("settings").at("cap_study").get<int>(), 64);
     EXPECT_TRUE(fs::exists(dir / "part_0" / "study.json") && fs::exists(dir / "part_1" / "study.json"));
+    // The cameras' classical side was rendered once, a camera per GPU, and every part took it from there.
+    for (const char* c : {"camera_0.json", "camera_1.json", "camera_0_reference.png", "camera_1_floor.png"})
+        EXPECT_TRUE(fs::exists(dir / "references" / c)) << c;
+    for (const char* part : {"part_0", "part_1"}) {
+        std::ifstream pf(dir / part / "study.json");
+        const nlohmann::json pj = nlohmann::json::parse(pf);
+        for (const auto& cam : pj.at("cameras")) EXPECT_TRUE(cam.at("from_references").get<bool>()) << part;
+    }
+}
+
+// --references: a second study of the same setup takes each camera's classical side from the folder and
+// gives the same figures to the last bit; a folder made by another setup, or damaged, is a one-line error.
+TEST(Study, ReferencesAreReusedAndGuarded) {
+    const fs::path dir = nbvh::test::temp_dir("study_refs_" + std::to_string(::getpid()));
+    const std::vector<std::string> a = {
+        "study",        "default", "--device",      "cpu", "--backend",    "cpu",
+        "--steps",      "10",      "--batch",       "128", "--nodes",      "15",
+        "--hash-log2",  "10",      "--lods",        "1",   "--threads",    "2",
+        "--cameras",    "1",       "--width",       "32",  "--height",     "32",
+        "--spp",        "2",       "--ref-spp",     "8",   "--repeat",     "1",
+        "--time-width", "16",      "--time-height", "16",  "--references", (dir / "refs").string()};
+    auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> v = a;
+        v.insert(v.end(), extra.begin(), extra.end());
+        return v;
+    };
+    // The first run keeps the equal-time FLIPs of every eighth up to 4x the compared spp.
+    const auto first = run_nbvh(with({"--out", (dir / "a").string(), "--equal-time-upto", "4"}), 300.0);
+    ASSERT_EQ(first.exit_code, 0) << first.describe();
+    const auto second = run_nbvh(with({"--out", (dir / "b").string()}), 300.0);
+    ASSERT_EQ(second.exit_code, 0) << second.describe();
+    EXPECT_NE(second.err.find("classical side from --references"), std::string::npos) << second.describe();
+    auto rows = [](const fs::path& p) {
+        std::ifstream f(p / "study.json");
+        return nlohmann::json::parse(f).at("rows");
+    };
+    const nlohmann::json ra = rows(dir / "a"), rb = rows(dir / "b");
+    ASSERT_EQ(ra.size(), rb.size());
+    for (size_t i = 0; i < ra.size(); ++i) {
+        for (const char* k : {"variant", "flip", "noise_floor", "classical_frame_ms"})
+            EXPECT_EQ(ra[i].at(k), rb[i].at(k)) << k << " of row " << i;
+    }
+    // Equal time follows the hybrid's frame time, measured anew in each run (lavapipe's varies): both runs
+    // took their equal-time FLIP from the kept ones (spp 3..8 here).
+    std::map<int, double> kept;
+    {
+        std::ifstream f(dir / "refs" / "camera_0.json");
+        const nlohmann::json j = nlohmann::json::parse(f); // alive through the loop
+        for (const auto& e : j.at("equal_time_flip"))
+            kept[e.at("spp").get<int>()] = e.at("flip").get<double>();
+    }
+    for (int spp = 2; spp <= 8;
+         ++spp) // the compared spp and every eighth up to 4x (the second run may add more)
+        EXPECT_EQ(kept.count(spp), 1u) << spp;
+    for (const nlohmann::json* r : {&ra, &rb})
+        for (const auto& row : *r)
+            if (row.at("variant") == "lod" && kept.count(row.at("equal_time_spp").get<int>())) {
+                EXPECT_EQ(row.at("equal_time_flip").get<double>(),
+                          kept.at(row.at("equal_time_spp").get<int>()));
+            }
+
+    const auto other = run_nbvh(with({"--out", (dir / "c").string(), "--max-depth", "4"}), 300.0);
+    EXPECT_EQ(check_clean_error(other, {"--references", "max_depth"}), "") << other.describe();
+    std::ofstream(dir / "refs" / "camera_0.json") << "{ not json";
+    const auto damaged = run_nbvh(with({"--out", (dir / "d").string()}), 300.0);
+    EXPECT_EQ(check_clean_error(damaged, {"camera_0.json"}), "") << damaged.describe();
+    const auto only = run_nbvh(with({"--out", (dir / "e").string(), "--reference-cameras", "0"}), 60.0);
+    EXPECT_EQ(check_clean_error(only, {"--reference-cameras", "--references-only"}), "") << only.describe();
 }
 
 TEST(Study, BadOptionsFailBeforeAnyWork) {
