@@ -11,7 +11,7 @@
 # Usage (GPU machine, after `source .device/env.sh`): scripts/bench/study_multi.sh default|dragon|chess OUT
 #   [extra nbvh study flags]
 # Env: GPUS (default: the GPUs nvidia-smi lists), PARTS (default for the 3 x 3 sweep below: balanced for
-#      GPUS = 1..4), BUDGET (minutes for the whole run, default 9.5: a part gets what is left when it
+#      any GPUS: at most 2 configurations a GPU from 5 GPUs on, the cheapest paired), BUDGET (minutes for the whole run, default 9.5: a part gets what is left when it
 #      starts), plus study.sh's (SPP, REF_SPP, ...). PARTS is a list of NODES:HASH sub-grids, e.g.
 #      "1000:14,16,18 2395:14,16 2395,8000:18 8000:14,16"; part i runs on GPU i % GPUS. PART_DEVICE
 #      (default gpu:N) replaces every part's --device: a dry run on the build machine, e.g.
@@ -32,7 +32,12 @@ if [ -z "${PARTS:-}" ]; then
     1) PARTS="1000,2395,8000:14,16,18" ;;
     2) PARTS="2395:14,16,18 1000:14,16,18 8000:18 8000:14,16" ;;
     3) PARTS="1000:14,16,18 2395:14,16,18 8000:14,16,18" ;;
-    *) PARTS="1000:14,16,18 2395:14,16 2395,8000:18 8000:14,16" ;;
+    4) PARTS="1000:14,16,18 2395:14,16 2395,8000:18 8000:14,16" ;;
+    5) PARTS="1000:14,16 1000,2395:18 2395:14,16 8000:14,16 8000:18" ;;
+    6) PARTS="1000:14,16 1000,2395:18 2395:14 2395:16 8000:14,16 8000:18" ;;
+    7) PARTS="1000:14,16 1000,2395:18 2395:14 2395:16 8000:14 8000:16 8000:18" ;;
+    8) PARTS="1000:14,16 1000:18 2395:14 2395:16 2395:18 8000:14 8000:16 8000:18" ;;
+    *) PARTS="1000:14 1000:16 1000:18 2395:14 2395:16 2395:18 8000:14 8000:16 8000:18" ;;
   esac
 fi
 mkdir -p "$OUT"
