@@ -82,42 +82,44 @@ void StudyRun::classical_side() {
         cam.classical = std::make_unique<WavefrontRenderer>(*ctx_, scene, accel_, env_, cam.camera, ref);
         if (cam.cached) {
             if (o_.save_images && c == 0) // the pixels are the PNG's: written as they are
-                save_png((fs::path(o_.out_dir) / "reference_cam0.png").string(), cam.reference_px);
-            progress_.note(strfmt(
-                "camera %zu: classical side from --references %s: noise floor %.4f, classical "
-                "%.3f ms/frame, %zu equal-time FLIPs",
-                c, o_.references_dir.c_str(), cam.noise_floor, cam.classical_ms, cam.equal_time_flip.size()));
+                save_png((fs::path(o_.out_dir) / "reference_cam0.png").string(), cam.kept.reference_px);
+            progress_.note(
+                strfmt("camera %zu: classical side from --references %s: noise floor %.4f, classical "
+                       "%.3f ms/frame, %zu equal-time FLIPs",
+                       c, o_.references_dir.c_str(), cam.kept.noise_floor, cam.kept.classical_ms,
+                       cam.kept.equal_time_flip.size()));
         } else {
             progress_.begin(StudyTask::render,
                             pixel_samples(o_.ref_spp) + pixel_samples(o_.render.spp) + timing_work(),
                             strfmt("camera %zu: classical reference (%u spp), noise floor (%u spp)", c,
                                    o_.ref_spp, o_.render.spp));
             render::RenderResult r = cam.classical->render();
-            cam.exposure = fixed_exposure_ ? *fixed_exposure_ : auto_exposure(r.image).stops;
-            const Image ref_px = as_png_pixels(r.image, cam.exposure);
-            if (o_.save_images && c == 0) save("reference_cam0.png", r.image, cam.exposure);
+            cam.kept.exposure = fixed_exposure_ ? *fixed_exposure_ : auto_exposure(r.image).stops;
+            const Image ref_px = as_png_pixels(r.image, cam.kept.exposure);
+            if (o_.save_images && c == 0) save("reference_cam0.png", r.image, cam.kept.exposure);
             RenderOptions same = image_options(o_.render.spp, o_.render.seed);
             same.neural.classical = true;
-            const Image floor_px = as_png_pixels(render_with(*cam.classical, same).image, cam.exposure);
+            const Image floor_px = as_png_pixels(render_with(*cam.classical, same).image, cam.kept.exposure);
             cam.film_spp = o_.render.spp;
             cam.ref_flip.emplace(ref_px);
             cam.floor_flip.emplace(floor_px);
-            cam.noise_floor = cam.ref_flip->compare(floor_px).mean;
+            cam.kept.noise_floor = cam.ref_flip->compare(floor_px).mean;
             std::unique_ptr<WavefrontRenderer> timing;
             if (separate_timing()) {
                 RenderOptions t = timing_options();
                 t.neural.classical = true;
                 timing = std::make_unique<WavefrontRenderer>(*ctx_, scene, accel_, env_, cam.camera, t);
             }
-            cam.classical_ms = time_frame(*cam.classical, timing.get(), same);
-            cam.equal_time_flip[o_.render.spp] = cam.noise_floor;
+            cam.kept.classical_ms = time_frame(*cam.classical, timing.get(), same);
+            cam.kept.equal_time_flip[o_.render.spp] = cam.kept.noise_floor;
             if (!o_.references_dir.empty()) { // kept at once: a later failure loses no render
-                cam.reference_px = ref_px, cam.floor_px = floor_px;
-                save_reference(o_.references_dir, c, reference_key(cam), cached_of(cam));
-                cam.kept_equal_time = cam.equal_time_flip.size();
+                cam.kept.reference_px = ref_px, cam.kept.floor_px = floor_px;
+                save_reference(o_.references_dir, c, reference_key(cam), cam.kept);
+                cam.kept_equal_time = cam.kept.equal_time_flip.size();
             }
             progress_.end(strfmt("noise floor %.4f, classical %.3f ms/frame (%u spp), exposure %+.2f stops",
-                                 cam.noise_floor, cam.classical_ms, o_.time_spp, cam.exposure));
+                                 cam.kept.noise_floor, cam.kept.classical_ms, o_.time_spp,
+                                 cam.kept.exposure));
         }
         if (o_.equal_time_upto > 0.0 && !cam.cached) { // equal-time FLIPs up front (kept with the references)
             uint32_t spp = 0;
@@ -130,13 +132,13 @@ void StudyRun::classical_side() {
         row.memory_bytes = source_bytes_;
         row.triangles = source_triangles_;
         row.compression = 1.0;
-        row.frame_ms = row.classical_frame_ms = cam.classical_ms;
+        row.frame_ms = row.classical_frame_ms = cam.kept.classical_ms;
         row.ratio_to_classical = 1.0;
-        row.flip = row.noise_floor = cam.noise_floor;
+        row.flip = row.noise_floor = cam.kept.noise_floor;
         row.flip_same_seed = 0.0;
         mark_floor(row);
         row.equal_time_spp = o_.render.spp;
-        row.equal_time_flip = cam.noise_floor;
+        row.equal_time_flip = cam.kept.noise_floor;
         rows_.push_back(row);
     }
     keep_references();
@@ -185,17 +187,6 @@ nlohmann::json StudyRun::reference_key(const CameraSide& cam) const {
             {"repeat", o_.repeat}};
 }
 
-CachedCamera StudyRun::cached_of(const CameraSide& cam) const {
-    CachedCamera k;
-    k.exposure = cam.exposure;
-    k.noise_floor = cam.noise_floor;
-    k.classical_ms = cam.classical_ms;
-    k.equal_time_flip = cam.equal_time_flip;
-    k.reference_px = cam.reference_px;
-    k.floor_px = cam.floor_px;
-    return k;
-}
-
 void StudyRun::load_references() {
     if (o_.references_dir.empty()) return;
     for (CameraSide& cam : cams_) {
@@ -205,25 +196,20 @@ void StudyRun::load_references() {
             throw Error(strfmt("--references %s: camera %zu's images are not %ux%u",
                                o_.references_dir.c_str(), cam.index, o_.render.width, o_.render.height));
         cam.cached = true;
-        cam.exposure = k->exposure;
-        cam.noise_floor = k->noise_floor;
-        cam.classical_ms = k->classical_ms;
-        cam.equal_time_flip = std::move(k->equal_time_flip);
-        cam.ref_flip.emplace(k->reference_px);
-        cam.floor_flip.emplace(k->floor_px);
-        cam.reference_px = std::move(k->reference_px);
-        cam.floor_px = std::move(k->floor_px);
+        cam.kept = std::move(*k);
+        cam.ref_flip.emplace(cam.kept.reference_px);
+        cam.floor_flip.emplace(cam.kept.floor_px);
         cam.film_spp = 0; // the film holds nothing of the compared seed: an equal-time miss renders anew
-        cam.kept_equal_time = cam.equal_time_flip.size();
+        cam.kept_equal_time = cam.kept.equal_time_flip.size();
     }
 }
 
 void StudyRun::keep_references() {
     if (o_.references_dir.empty()) return;
     for (CameraSide& cam : cams_) {
-        if (!cam.ref_flip || cam.equal_time_flip.size() == cam.kept_equal_time) continue; // nothing new
-        save_reference(o_.references_dir, cam.index, reference_key(cam), cached_of(cam));
-        cam.kept_equal_time = cam.equal_time_flip.size();
+        if (!cam.ref_flip || cam.kept.equal_time_flip.size() == cam.kept_equal_time) continue; // nothing new
+        save_reference(o_.references_dir, cam.index, reference_key(cam), cam.kept);
+        cam.kept_equal_time = cam.kept.equal_time_flip.size();
     }
 }
 
@@ -239,26 +225,28 @@ double StudyRun::equal_time(CameraSide& cam, double ratio, uint32_t* spp_out) {
     const uint32_t eighths = uint32_t(std::max(1.0, std::round(8.0 * ratio)));
     const uint32_t spp = spp_of(eighths);
     *spp_out = spp;
-    if (auto it = cam.equal_time_flip.find(spp); it != cam.equal_time_flip.end()) return it->second;
-    auto flip_of = [&](const Image& linear) { return cam.ref_flip->compare(as_png_pixels(linear, cam.exposure)).mean; };
+    if (auto it = cam.kept.equal_time_flip.find(spp); it != cam.kept.equal_time_flip.end()) return it->second;
+    auto flip_of = [&](const Image& linear) {
+        return cam.ref_flip->compare(as_png_pixels(linear, cam.kept.exposure)).mean;
+    };
     if (spp > base && (cam.film_spp == 0 || cam.classical->accumulated_samples() != cam.film_spp))
         start_film(cam); // the floor's samples again, extended below as in the run that made the reference
     const bool extend = cam.film_spp > 0 && cam.film_spp < spp && cam.classical->accumulated_samples() == cam.film_spp;
     if (!extend) {
         RenderOptions opt = image_options(spp, o_.render.seed);
         opt.neural.classical = true;
-        cam.equal_time_flip[spp] = flip_of(render_with(*cam.classical, opt).image);
+        cam.kept.equal_time_flip[spp] = flip_of(render_with(*cam.classical, opt).image);
         cam.film_spp = spp;
-        return cam.equal_time_flip[spp];
+        return cam.kept.equal_time_flip[spp];
     }
     for (uint32_t e = 1; cam.film_spp < spp; ++e) {
         const uint32_t next = spp_of(e);
         if (next <= cam.film_spp) continue;
         const Image mean = cam.classical->render_progressive(next - cam.film_spp).image;
         cam.film_spp = next;
-        if (!cam.equal_time_flip.count(next)) cam.equal_time_flip[next] = flip_of(mean);
+        if (!cam.kept.equal_time_flip.count(next)) cam.kept.equal_time_flip[next] = flip_of(mean);
     }
-    return cam.equal_time_flip.at(spp);
+    return cam.kept.equal_time_flip.at(spp);
 }
 
 } // namespace nbvh::app::study

@@ -189,17 +189,17 @@ void StudyRun::run_config(size_t index, const Config& c) {
             row.train_seconds = tr.seconds;
             row.final_loss = tr.log.back().loss.total;
             row.frame_ms = time_frame(hybrid, timing, vo);
-            row.classical_frame_ms = cam.classical_ms;
-            row.ratio_to_classical = row.frame_ms / cam.classical_ms;
+            row.classical_frame_ms = cam.kept.classical_ms;
+            row.ratio_to_classical = row.frame_ms / cam.kept.classical_ms;
             const render::RenderResult res = render_with(hybrid, vo);
-            const Image px = as_png_pixels(res.image, cam.exposure);
+            const Image px = as_png_pixels(res.image, cam.kept.exposure);
             row.queries_per_ray = res.stats.neural_queries_per_ray();
             row.leaf_cap_fraction = res.stats.rays_total() ? double(res.stats.neural_leaf_cap_rays) /
                                                                  double(res.stats.rays_total())
                                                            : 0.0;
             kernel_ = res.stats.neural_path;
             row.flip = cam.ref_flip->compare(px).mean;
-            row.noise_floor = cam.noise_floor;
+            row.noise_floor = cam.kept.noise_floor;
             row.flip_same_seed = cam.floor_flip->compare(px).mean;
             if (v.kind == "lod" && v.lod == 0) base_px = px;
             if (v.kind == "cap" && base_px.width) row.flip_vs_base_cap = flip_ldr(base_px, px).mean;
@@ -207,7 +207,7 @@ void StudyRun::run_config(size_t index, const Config& c) {
                 row.equal_time_flip = equal_time(cam, row.ratio_to_classical, &row.equal_time_spp);
             mark_floor(row);
             if (o_.save_images && index == 0 && ci == 0 && v.kind == "lod" && v.lod == 0)
-                save("hybrid_cam0.png", res.image, cam.exposure);
+                save("hybrid_cam0.png", res.image, cam.kept.exposure);
             rows_.push_back(row);
             progress_.end(strfmt("FLIP %.4f (floor %.4f%s), %.2fx classical, %.2f MiB", row.flip,
                                  row.noise_floor, row.within_2x_floor ? ", within 2x floor" : "",
@@ -231,15 +231,16 @@ void StudyRun::run_config(size_t index, const Config& c) {
             row.compression = double(source_bytes_) / double(dec->bytes);
             row.decimation_sloppy = dec->sloppy;
             row.frame_ms = time_frame(*dr, dtiming.get(), dopt);
-            row.classical_frame_ms = cam.classical_ms;
-            row.ratio_to_classical = row.frame_ms / cam.classical_ms;
+            row.classical_frame_ms = cam.kept.classical_ms;
+            row.ratio_to_classical = row.frame_ms / cam.kept.classical_ms;
             const render::RenderResult res = render_with(*dr, dopt);
-            const Image px = as_png_pixels(res.image, cam.exposure);
+            const Image px = as_png_pixels(res.image, cam.kept.exposure);
             row.flip = cam.ref_flip->compare(px).mean;
-            row.noise_floor = cam.noise_floor;
+            row.noise_floor = cam.kept.noise_floor;
             row.flip_same_seed = cam.floor_flip->compare(px).mean;
             mark_floor(row);
-            if (o_.save_images && index == 0 && ci == 0) save("decimated_cam0.png", res.image, cam.exposure);
+            if (o_.save_images && index == 0 && ci == 0)
+                save("decimated_cam0.png", res.image, cam.kept.exposure);
             rows_.push_back(row);
             progress_.end(strfmt("FLIP %.4f (floor %.4f), %.2f MiB (%+.1f %% of the model's)", row.flip,
                                  row.noise_floor, double(dec->bytes) / 1048576.0,

@@ -36,20 +36,20 @@ struct Config {
 // Everything of one camera that every configuration compares against.
 struct CameraSide {
     Camera camera;
-    size_t index = 0;       // the camera's number in the study (file names of --references, result rows)
-    bool cached = false;    // its classical side came from --references
-    float exposure = 0.0f;  // stops of every PNG of this camera (the reference's auto exposure)
+    size_t index = 0;    // the camera's number in the study (file names of --references, result rows)
+    bool cached = false; // its classical side came from --references
+    // Its classical side: the exposure of every PNG of this camera (the reference's auto exposure), the
+    // noise floor, the classical frame time, the equal-time FLIPs (classical spp -> FLIP vs the reference)
+    // and, with --references, the reference and floor images as PNG pixels: what the folder keeps.
+    CachedCamera kept;
     // The reference (ref_spp) and the classical image (spp, compared seed) as PNG pixels, prepared once
     // for the FLIPs of every row (FlipReference: the same figures as flip_ldr, half the filtering).
     std::optional<FlipReference> ref_flip, floor_flip;
-    double noise_floor = 0.0, classical_ms = 0.0;
     std::unique_ptr<WavefrontRenderer> classical; // image size: reference, floor, equal-time renders
-    std::map<uint32_t, double> equal_time_flip;   // classical spp -> FLIP vs the reference
     // Samples of the compared seed in `classical`'s film (the floor render, then equal-time extensions);
     // 0 when the film holds something else.
     uint32_t film_spp = 0;
-    Image reference_px, floor_px; // kept for --references (empty without it)
-    size_t kept_equal_time = 0;   // equal-time FLIPs in --references as last written or read
+    size_t kept_equal_time = 0; // equal-time FLIPs in --references as last written or read
 };
 
 class StudyRun {
@@ -112,7 +112,6 @@ class StudyRun {
     nlohmann::json reference_key(const CameraSide& cam) const; // what makes a camera's classical side
     void load_references(); // the cameras --references holds (before plan(): theirs is no work)
     void keep_references(); // every camera's classical side into --references (equal-time FLIPs grown)
-    CachedCamera cached_of(const CameraSide& cam) const;
     void run_config(size_t index, const Config& c);
     TrainOptions train_options(const Config& c) const; // validated (throws nbvh::Error)
     double equal_time(CameraSide& cam, double ratio, uint32_t* spp_out);

@@ -84,9 +84,9 @@ void StudyRun::write_results() const {
         cams.push_back({{"camera", cams_[c].index},
                         {"from_references", cams_[c].cached},
                         {"view", camera_string(cams_[c].camera)},
-                        {"exposure_stops", cams_[c].exposure},
-                        {"noise_floor", cams_[c].noise_floor},
-                        {"classical_frame_ms", cams_[c].classical_ms}});
+                        {"exposure_stops", cams_[c].kept.exposure},
+                        {"noise_floor", cams_[c].kept.noise_floor},
+                        {"classical_frame_ms", cams_[c].kept.classical_ms}});
     nlohmann::json rows = nlohmann::json::array(), mean_rows = nlohmann::json::array();
     for (const StudyRow& r : rows_) rows.push_back(row_json(r));
     for (const StudyRow& r : means) mean_rows.push_back(row_json(r));
