@@ -60,23 +60,24 @@ bool blended(const TrainingAsset& asset, const TrainingPart& part) {
 
 // --device gpu:N: the UUID of the N-th GPU as every other command counts them (Vulkan, PCI bus order,
 // nvidia-smi's numbering), so that CUDA trains on it; empty for auto and gpu (CUDA's first device).
-std::string training_gpu_uuid(const std::string& device) {
+std::string training_gpu_uuid(const std::string& device, const std::string& backend) {
     const vk::DeviceSpec spec = vk::parse_device_spec(device);
     if (spec.choice == vk::DeviceChoice::cpu)
         throw Error(
             "--device cpu: the CPU trainer is --backend cpu (--device picks the GPU: auto, gpu or gpu:N)");
     if (spec.gpu_index < 0) return {};
+    if (parse_backend(backend) == BackendChoice::cpu)
+        throw Error("--device " + device +
+                    " picks the GPU that CUDA trains on; it does not go with --backend cpu");
     vk::ContextOptions copt;
-    copt.set_device(device);
+    copt.device = spec.choice;
+    copt.gpu_index = spec.gpu_index;
     const vk::Context ctx(copt); // throws the one-line error of a GPU number beyond the last
     return ctx.features().device_uuid;
 }
 
 void run_train(const TrainArgs& a) {
-    if (vk::parse_device_spec(a.device).gpu_index >= 0 && parse_backend(a.backend) == BackendChoice::cpu)
-        throw Error("--device " + a.device +
-                    " picks the GPU that CUDA trains on; it does not go with --backend cpu");
-    use_cuda_device(training_gpu_uuid(a.device)); // gpu:N; nothing for auto and gpu
+    use_cuda_device(training_gpu_uuid(a.device, a.backend)); // gpu:N; nothing for auto and gpu
     const BackendChoice backend = resolve_backend(parse_backend(a.backend));
     TrainOptions opt = default_train_options(backend);
     if (a.nodes) opt.target_nodes = *a.nodes;

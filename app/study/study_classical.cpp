@@ -26,7 +26,6 @@
 #include "engine/core/flip.h"
 #include "engine/core/log.h"
 #include "engine/neural/asset_table.h"
-#include "engine/neural/model_file.h"
 #include "engine/render/decimation.h"
 #include "engine/render/gpu_memory.h"
 #include "engine/render/wavefront.h"
@@ -165,9 +164,7 @@ nlohmann::json StudyRun::reference_key(const CameraSide& cam) const {
             {"neural", o_.neural_glob},
             {"camera", camera_string(cam.camera)},
             {"env", o_.env},
-            {"env_hash", o_.env.empty() || o_.env == "none"
-                             ? std::string()
-                             : strfmt("%016llx", (unsigned long long)fnv1a64_file(o_.env))},
+            {"env_hash", env_hash_},
             {"env_rotation", o_.env_rotation ? *o_.env_rotation : 0.0f},
             {"width", o_.render.width},
             {"height", o_.render.height},

@@ -43,8 +43,7 @@ void save_pixels(const fs::path& png, const Image& px) {
     }
 }
 
-} // namespace
-
+// The first field (in `expected`'s order) whose value differs in `found`, or "" when none does.
 std::string first_difference(const nlohmann::json& expected, const nlohmann::json& found) {
     for (auto it = expected.begin(); it != expected.end(); ++it) {
         if (!found.is_object() || !found.contains(it.key())) return it.key();
@@ -52,6 +51,8 @@ std::string first_difference(const nlohmann::json& expected, const nlohmann::jso
     }
     return {};
 }
+
+} // namespace
 
 std::optional<CachedCamera> load_reference(const std::string& dir, size_t index, const nlohmann::json& key) {
     const fs::path meta = file_of(dir, index, ".json");

@@ -35,7 +35,4 @@ std::optional<CachedCamera> load_reference(const std::string& dir, size_t index,
 // Writes camera `index` to `dir` (created), each file replaced whole (written aside, then renamed).
 void save_reference(const std::string& dir, size_t index, const nlohmann::json& key, const CachedCamera& cam);
 
-// The first field (in `expected`'s order) whose value differs in `found`, or "" when none does.
-std::string first_difference(const nlohmann::json& expected, const nlohmann::json& found);
-
 } // namespace nbvh::app::study

@@ -133,6 +133,7 @@ class StudyRun {
     std::vector<Config> configs_;
     uint64_t source_bytes_ = 0, source_triangles_ = 0;
     std::string device_, driver_, train_device_, kernel_;
+    std::string env_hash_; // of the --env file's bytes (empty without one): in each camera's --references key
     std::vector<StudyRow> rows_;
     nlohmann::json config_json_ = nlohmann::json::array();
     std::string started_, stop_reason_;

@@ -28,6 +28,7 @@
 #include "engine/core/flip.h"
 #include "engine/core/log.h"
 #include "engine/neural/asset_table.h"
+#include "engine/neural/model_file.h"
 #include "engine/render/decimation.h"
 #include "engine/render/gpu_memory.h"
 #include "engine/render/wavefront.h"
@@ -175,6 +176,8 @@ void StudyRun::run() {
     ts_ = load_training_scene(o_.scene, o_.neural_glob, o_.asset_glob);
     env_ = choose_environment(ts_.scene, o_.env);
     if (o_.env_rotation) env_.rotation = *o_.env_rotation * 3.14159265358979f / 180.0f;
+    if (!o_.references_dir.empty() && !o_.env.empty() && o_.env != "none")
+        env_hash_ = strfmt("%016llx", (unsigned long long)fnv1a64_file(o_.env));
     cams_.resize(0);
     const std::vector<Camera> cameras = study_cameras(ts_.scene, o_.cameras, o_.camera_count,
                                                       float(o_.render.width) / float(o_.render.height));

@@ -43,6 +43,19 @@ bool is_png(const fs::path& p) {
            fs::file_size(p) > 1000;
 }
 
+nlohmann::json read_json(const fs::path& p) {
+    std::ifstream f(p);
+    return nlohmann::json::parse(f);
+}
+
+// The kept equal-time FLIPs of camera 0 in a --references folder: classical spp -> FLIP.
+std::map<int, double> kept_equal_time(const fs::path& refs) {
+    std::map<int, double> kept;
+    const nlohmann::json j = read_json(refs / "camera_0.json");
+    for (const auto& e : j.at("equal_time_flip")) kept[e.at("spp").get<int>()] = e.at("flip").get<double>();
+    return kept;
+}
+
 // The tiny sweep's command: `nodes` are the node budgets.
 std::vector<std::string> tiny_args(const fs::path& out, const std::string& nodes) {
     // Frames timed at another size than the images: their own renderers.
@@ -220,8 +233,7 @@ TEST(Study, BudgetStopsBetweenConfigurations) {
                              "0.0001"},
                             300.0);
     ASSERT_EQ(r.exit_code, 0) << r.describe();
-    std::ifstream jf(dir / "study.json");
-    const nlohmann::json j = nlohmann::json::parse(jf);
+    const nlohmann::json j = read_json(dir / "study.json");
     EXPECT_FALSE(j["complete"].get<bool>());
     EXPECT_EQ(j["configs_done"].get<int>(), 1);
     EXPECT_EQ(j["configs_planned"].get<int>(), 2);
@@ -239,8 +251,7 @@ TEST(Study, ASweepsLaterConfigurationRendersAsAFreshStudy) {
     const auto r = run_nbvh(tiny_args(alone, "63"), 500.0);
     ASSERT_EQ(r.exit_code, 0) << r.describe();
     auto rows_of = [](const fs::path& dir, int config) {
-        std::ifstream f(dir / "study.json");
-        const nlohmann::json j = nlohmann::json::parse(f);
+        const nlohmann::json j = read_json(dir / "study.json");
         std::vector<nlohmann::json> out;
         for (const auto& row : j["rows"])
             if (row["config"].get<int>() == config && row["variant"] != "classical") out.push_back(row);
@@ -316,8 +327,7 @@ TEST(Study, PartsRunInParallelAndMergeIntoOneStudy) {
     for (const char* c : {"camera_0.json", "camera_1.json", "camera_0_reference.png", "camera_1_floor.png"})
         EXPECT_TRUE(fs::exists(dir / "references" / c)) << c;
     for (const char* part : {"part_0", "part_1"}) {
-        std::ifstream pf(dir / part / "study.json");
-        const nlohmann::json pj = nlohmann::json::parse(pf);
+        const nlohmann::json pj = read_json(dir / part / "study.json");
         for (const auto& cam : pj.at("cameras")) EXPECT_TRUE(cam.at("from_references").get<bool>()) << part;
     }
 }
@@ -338,40 +348,34 @@ TEST(Study, ReferencesAreReusedAndGuarded) {
         v.insert(v.end(), extra.begin(), extra.end());
         return v;
     };
-    // The first run keeps the equal-time FLIPs of every eighth up to 4x the compared spp.
-    const auto first = run_nbvh(with({"--out", (dir / "a").string(), "--equal-time-upto", "4"}), 300.0);
+    // The first run keeps the equal-time FLIPs of every eighth up to 16x the compared spp (lavapipe's
+    // hybrid frames take 2-5x the classical one), so both runs' equal-time rows fall among them.
+    const auto first = run_nbvh(with({"--out", (dir / "a").string(), "--equal-time-upto", "16"}), 300.0);
     ASSERT_EQ(first.exit_code, 0) << first.describe();
+    const std::map<int, double> kept = kept_equal_time(dir / "refs");
+    for (int spp = 2; spp <= 32; ++spp)
+        EXPECT_EQ(kept.count(spp), 1u) << spp; // the compared 2 spp, then eighths
     const auto second = run_nbvh(with({"--out", (dir / "b").string()}), 300.0);
     ASSERT_EQ(second.exit_code, 0) << second.describe();
     EXPECT_NE(second.err.find("classical side from --references"), std::string::npos) << second.describe();
-    auto rows = [](const fs::path& p) {
-        std::ifstream f(p / "study.json");
-        return nlohmann::json::parse(f).at("rows");
-    };
-    const nlohmann::json ra = rows(dir / "a"), rb = rows(dir / "b");
+    const nlohmann::json ra = read_json(dir / "a" / "study.json").at("rows");
+    const nlohmann::json rb = read_json(dir / "b" / "study.json").at("rows");
     ASSERT_EQ(ra.size(), rb.size());
+    int equal_time_rows = 0;
     for (size_t i = 0; i < ra.size(); ++i) {
         for (const char* k : {"variant", "flip", "noise_floor", "classical_frame_ms"})
             EXPECT_EQ(ra[i].at(k), rb[i].at(k)) << k << " of row " << i;
+        // Equal time follows the hybrid's frame time, measured anew in each run: each run's equal-time
+        // FLIP is the one the first run kept for that spp.
+        for (const nlohmann::json* row : {&ra[i], &rb[i]}) {
+            if (row->at("variant") != "lod") continue;
+            const int spp = row->at("equal_time_spp").get<int>();
+            ASSERT_EQ(kept.count(spp), 1u) << "equal-time spp " << spp << " beyond the kept ones";
+            EXPECT_EQ(row->at("equal_time_flip").get<double>(), kept.at(spp)) << "row " << i;
+            ++equal_time_rows;
+        }
     }
-    // Equal time follows the hybrid's frame time, measured anew in each run (lavapipe's varies): both runs
-    // took their equal-time FLIP from the kept ones (spp 3..8 here).
-    std::map<int, double> kept;
-    {
-        std::ifstream f(dir / "refs" / "camera_0.json");
-        const nlohmann::json j = nlohmann::json::parse(f); // alive through the loop
-        for (const auto& e : j.at("equal_time_flip"))
-            kept[e.at("spp").get<int>()] = e.at("flip").get<double>();
-    }
-    for (int spp = 2; spp <= 8;
-         ++spp) // the compared spp and every eighth up to 4x (the second run may add more)
-        EXPECT_EQ(kept.count(spp), 1u) << spp;
-    for (const nlohmann::json* r : {&ra, &rb})
-        for (const auto& row : *r)
-            if (row.at("variant") == "lod" && kept.count(row.at("equal_time_spp").get<int>())) {
-                EXPECT_EQ(row.at("equal_time_flip").get<double>(),
-                          kept.at(row.at("equal_time_spp").get<int>()));
-            }
+    EXPECT_EQ(equal_time_rows, 2) << "LoD 0 of each run";
 
     const auto other = run_nbvh(with({"--out", (dir / "c").string(), "--max-depth", "4"}), 300.0);
     EXPECT_EQ(check_clean_error(other, {"--references", "max_depth"}), "") << other.describe();
