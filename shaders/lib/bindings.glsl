@@ -114,8 +114,8 @@ bool nb_shadow_is_marked_occluded(float tmax) { return tmax < 0.0f; }
 // Random bits of a ray's stochastic alpha coverage (shared/scene_gpu.h nb_alpha_covers): a path ray's
 // are its NB_RAY_RNG word; a shadow ray's come from its path's slot in the wave (pixel, sample, depth).
 uint nb_shadow_alpha_seed(uint slot) {
-    uint pixel = nb_slot_pixel(slot, pc.pixel_offset, pc.pixel_count);
-    return nb_pcg_hash(pixel ^ (pc.depth << 24u) ^ nb_slot_sample(slot, pc.sample_index, pc.pixel_count));
+    uint pixel = nb_slot_pixel(slot, pc.pixel_offset, pc.wave_samples);
+    return nb_pcg_hash(pixel ^ (pc.depth << 24u) ^ nb_slot_sample(slot, pc.sample_index, pc.wave_samples));
 }
 
 // Ray-sort bin of a ray (shared/wavefront_gpu.h nb_rs_key) in the scene's bounds (the sort header).

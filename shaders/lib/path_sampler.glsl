@@ -27,8 +27,8 @@ struct PathSampler {
 PathSampler nb_path_sampler(uint slot, uint depth, uint rng) {
     PathSampler ps;
     ps.rng = rng;
-    ps.pixel_seed = nb_qmc_pixel_seed(nb_slot_pixel(slot, pc.pixel_offset, pc.pixel_count), params.seed);
-    ps.sample_index = nb_slot_sample(slot, pc.sample_index, pc.pixel_count);
+    ps.pixel_seed = nb_qmc_pixel_seed(nb_slot_pixel(slot, pc.pixel_offset, pc.wave_samples), params.seed);
+    ps.sample_index = nb_slot_sample(slot, pc.sample_index, pc.wave_samples);
     ps.depth = depth;
     return ps;
 }

@@ -12,7 +12,7 @@ void main() {
     vec4 sum = vec4(0.0f);
     uint bad = 0u;
     for (uint s = 0u; s < pc.wave_samples; ++s) {
-        vec3 l = sample_radiance[s * pc.pixel_count + i];
+        vec3 l = sample_radiance[i * pc.wave_samples + s]; // pixel-major slots (shared/wavefront_gpu.h)
         if (any(isnan(l)) || any(isinf(l))) ++bad;
         else sum += vec4(l, 1.0f);
     }

@@ -15,7 +15,7 @@ void main() {
         else counters.ray_count1 = paths;
     }
     if (i >= paths) return;
-    uint pixel = nb_slot_pixel(i, pc.pixel_offset, pc.pixel_count);
+    uint pixel = nb_slot_pixel(i, pc.pixel_offset, pc.wave_samples);
     uint x = pixel % params.width;
     uint y = pixel / params.width;
     PathSampler ps = nb_camera_path_sampler(i, pixel);
