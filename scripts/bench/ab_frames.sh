@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # A/B frame times of two nbvh binaries in one run on one GPU (issue 14: each step's measurement):
-# hybrid and classical 1920x1080 frames of the default scene and the dragon, max depth 8, the models
+# hybrid and classical 1920x1080 frames of the default scene and the dragon (and Chess with CHESS=1),
+# max depth 8, the models
 # trained once (CUDA defaults of the NEW binary; the model format is shared), then per row a warm-up
 # render and OLD, NEW, OLD, NEW (interleaved: clocks and caches drift alike), same seed. Reports the
 # fastest of each binary's two renders in ms per sample, per-pass times, and the FLIP between the OLD and
 # NEW images (0 when the change is exact). Writes OUT/ab.json and prints a table.
 # Usage (GPU machine, after `source .device/env.sh`): scripts/bench/ab_frames.sh OLD NEW OUT
-# Env: DRAGON (xz-packed glb, default .device/study/dragon/dragon_vrip.glb.xz), SPP (default 16), WIDTH, HEIGHT,
+# Env: DRAGON (xz-packed glb, default .device/study/dragon/dragon_vrip.glb.xz), CHESS=1 (also Chess: the
+#      paper's camera and environment, lib.sh bench_scene; carry .device/study/chess), SPP (default 16), WIDTH, HEIGHT,
 #      TRAIN_ARGS (extra `nbvh train` flags for both models), RENDER_ARGS (extra render flags, both binaries),
 #      OLD_TRAIN_ARGS (when set, OLD renders its own models, trained by OLD with these flags: an A/B of
 #      training settings; OLD may then be the same binary as NEW), OLD_RENDER_ARGS (extra render flags
@@ -56,11 +58,21 @@ row default_classical default --classical
 row default_hybrid default --model @M@/default.nbvh
 row dragon_classical "$T/dragon.glb" --neural '*' --classical
 row dragon_hybrid "$T/dragon.glb" --model @M@/dragon.nbvh
+if [ "${CHESS:-0}" = 1 ]; then
+  bench_scene chess "$T"
+  "$NEW" train "${SRC[@]}" "${NEURAL[@]}" "${TA[@]}" --out "$T/chess.nbvh" > "$T/train_chess.log" 2>&1
+  [ -n "${OLD_TRAIN_ARGS+x}" ] && "$OLD" train "${SRC[@]}" "${NEURAL[@]}" "${OTA[@]}" --out "$OLDM/chess.nbvh" \
+    > "$T/train_chess_old.log" 2>&1
+  cp "$T"/train_chess*.log "$OUT"/
+  row chess_classical "${SRC[@]}" "${NEURAL[@]}" --classical "${VIEW[@]}"
+  row chess_hybrid "${SRC[@]}" --model @M@/chess.nbvh "${VIEW[@]}"
+fi
 python3 - "$T" "$OUT/ab.json" "$OLD" "$NEW" <<'PY'
 import glob, json, os, re, sys
 t, out = sys.argv[1], sys.argv[2]
 rows = {}
-for name in ["default_classical", "default_hybrid", "dragon_classical", "dragon_hybrid"]:
+names = ["default_classical", "default_hybrid", "dragon_classical", "dragon_hybrid", "chess_classical", "chess_hybrid"]
+for name in [n for n in names if glob.glob(os.path.join(t, n + "_old_*.json"))]:
     r = {}
     for b in ["old", "new"]:
         runs = [json.load(open(f)) for f in sorted(glob.glob(os.path.join(t, f"{name}_{b}_*.json")))]
