@@ -209,3 +209,30 @@ TEST(WavePlan, QueryCounterCarriesIntoItsHighWord) {
     }
     EXPECT_GT(hi, 1000u);
 }
+
+// Wave slots are pixel-major (shared/wavefront_gpu.h): a pixel's samples take neighbouring slots, so a
+// subgroup's camera rays are few pixels' samples; every (pixel, sample) of the wave has exactly one slot,
+// also in a wave of fewer samples (an image's last wave) and of an offset pixel range.
+TEST(WavePlan, SlotsArePixelMajorAndCoverEachPixelSampleOnce) {
+    const uint32_t offsets[] = {0u, 1000u};
+    for (uint32_t offset : offsets)
+        for (uint32_t samples : {1u, 5u, 16u})
+            for (uint32_t first_sample : {0u, 16u}) {
+                const uint32_t pixels = 37;
+                std::vector<int> seen(size_t(pixels) * samples, 0);
+                for (uint32_t slot = 0; slot < pixels * samples; ++slot) {
+                    const uint32_t p = nb_slot_pixel(slot, offset, samples);
+                    const uint32_t s = nb_slot_sample(slot, first_sample, samples);
+                    ASSERT_GE(p, offset);
+                    ASSERT_LT(p - offset, pixels);
+                    ASSERT_GE(s, first_sample);
+                    ASSERT_LT(s - first_sample, samples);
+                    ++seen[size_t(p - offset) * samples + (s - first_sample)];
+                    if (slot % samples != 0u) { // the previous slot is the same pixel's previous sample
+                        EXPECT_EQ(nb_slot_pixel(slot - 1u, offset, samples), p);
+                        EXPECT_EQ(nb_slot_sample(slot - 1u, first_sample, samples), s - 1u);
+                    }
+                }
+                for (int n : seen) ASSERT_EQ(n, 1);
+            }
+}
