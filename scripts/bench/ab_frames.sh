@@ -3,9 +3,8 @@
 # hybrid and classical 1920x1080 frames of the default scene and the dragon (and Chess with CHESS=1),
 # max depth 8, the models trained once (CUDA defaults of the NEW binary; the model format is shared),
 # then per row a warm-up render and OLD, NEW, OLD, NEW (interleaved: clocks and caches drift alike),
-# same seed. Reports the
-# fastest of each binary's two renders in ms per sample, per-pass times, and the FLIP between the OLD and
-# NEW images (0 when the change is exact). Writes OUT/ab.json and prints a table.
+# same seed. Reports the fastest of each binary's two renders in ms per sample, per-pass times, and the
+# FLIP between the OLD and NEW images (0 when the change is exact). Writes OUT/ab.json, prints a table.
 # Usage (GPU machine, after `source .device/env.sh`): scripts/bench/ab_frames.sh OLD NEW OUT
 # Env: DRAGON (xz-packed glb, default .device/study/dragon/dragon_vrip.glb.xz), CHESS=1 (also Chess: the
 #      paper's camera and environment, lib.sh bench_scene; carry .device/study/chess), SPP (default 16), WIDTH, HEIGHT,
