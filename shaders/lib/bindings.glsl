@@ -65,6 +65,8 @@ layout(set = 0, binding = NB_BIND_RAY_SORT, std430) buffer RaySortBuffer {
     uint rs_bins[NB_RS_HEADER_WORDS];
     uint rs_order[];
 };
+// The same buffer in 16-byte units (queue_args.comp scans and zeroes the bins 4 at a time).
+layout(set = 0, binding = NB_BIND_RAY_SORT, std430) buffer RaySortBins4 { uvec4 rs_bins4[]; };
 
 // ---- SOA accessors (layout: shared/wavefront_gpu.h) ----------------------------------------------
 uint ray_capacity() { return params.wave_capacity; }

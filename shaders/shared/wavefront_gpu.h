@@ -121,12 +121,13 @@ NB_STATIC_ASSERT(sizeof(GpuQueueCounters) == 68 + 8 * NB_STAT_DEPTHS, "GpuQueueC
 
 // ---- Ray order of the classical traversal and shadow passes (RenderOptions::sort_rays) -------------
 // Secondary and shadow rays are incoherent; the traversal and shadow passes visit them bin by bin, bins
-// in Morton order of (direction octant, 8^3 cell of the origin in the scene's bounds), so that a warp's
-// rays walk the same BVH nodes. A counting sort per queue: shade.comp counts each ray it appends in its
-// queue's bins, queue_args.comp turns the counts into offsets (exclusive scan) and zeroes the bins the
-// next shade pass counts into, passes/ray_sort.comp scatters the ray indices, and the pass reads ray
-// order[k]. The order within a bin is whatever the atomics give; each ray's result goes to its own slot.
-#define NB_RS_BINS 4096u
+// in order of (direction cell: 4 levels per axis of the unit direction, Morton code of the origin's 8^3
+// cell in the scene's bounds), so that a warp's rays walk the same BVH nodes. A counting sort per queue:
+// shade.comp counts each ray it appends in its queue's bins, queue_args.comp turns the counts into offsets
+// (exclusive scan) and zeroes the bins the next shade pass counts into, passes/ray_sort.comp scatters the ray
+// indices, and the pass reads ray order[k]. The order within a bin is whatever the atomics give; each ray's
+// result goes to its own slot.
+#define NB_RS_BINS 32768u       // 2^(6 direction bits + 9 origin bits)
 #define NB_RS_SCAN_THREADS 128u // queue_args.comp's workgroup: Vulkan's guaranteed minimum size
 // Sort binding layout (words): path-queue bins for queue 0 and 1, shadow bins, the scene's world bounds
 // (lo.xyz, hi.xyz as floats, written by the host), then the order of the path queue being traced
@@ -137,8 +138,15 @@ NB_STATIC_ASSERT(sizeof(GpuQueueCounters) == 68 + 8 * NB_STAT_DEPTHS, "GpuQueueC
 #define NB_RS_HEADER_WORDS (3u * NB_RS_BINS + 8u)
 // Spreads the low 3 bits of v to bits 0, 3, 6.
 NB_FN uint nb_rs_spread3(uint v) { return (v & 1u) | ((v & 2u) << 2u) | ((v & 4u) << 4u); }
-// Bin of a ray with origin o and direction d in a scene with bounds [lo, hi]: the direction octant in
-// the top 3 bits, the Morton code (x lowest) of the origin's cell of an 8^3 grid below.
+// Level 0..3 of a unit direction's component c: [-1, -0.5), [-0.5, 0), [0, 0.5), [0.5, 1]; -0 and NaN
+// count as non-negative (level 2), so a level's top bit is the octant's sign bit inverted.
+NB_FN uint nb_rs_dir_level(float c) {
+    float t = (c + 1.0f) * 2.0f;
+    if (t >= 0.0f) return uint(min(t, 3.0f));
+    return c < 0.0f ? 0u : 2u; // below -1 by rounding: 0; NaN: 2
+}
+// Bin of a ray with origin o and direction d in a scene with bounds [lo, hi]: the direction's levels in
+// the top 6 bits (x lowest), the Morton code (x lowest) of the origin's cell of an 8^3 grid below.
 NB_FN uint nb_rs_key(vec3 o, vec3 d, vec3 lo, vec3 hi) {
     vec3 ext = max(hi - lo, vec3(1e-30f));
     vec3 f = (o - lo) / ext * 8.0f;
@@ -146,8 +154,9 @@ NB_FN uint nb_rs_key(vec3 o, vec3 d, vec3 lo, vec3 hi) {
     uint cx = uint(f.x >= 0.0f ? min(f.x, 7.0f) : 0.0f);
     uint cy = uint(f.y >= 0.0f ? min(f.y, 7.0f) : 0.0f);
     uint cz = uint(f.z >= 0.0f ? min(f.z, 7.0f) : 0.0f);
-    uint oct = (d.x < 0.0f ? 1u : 0u) | (d.y < 0.0f ? 2u : 0u) | (d.z < 0.0f ? 4u : 0u);
-    return (oct << 9u) | nb_rs_spread3(cx) | (nb_rs_spread3(cy) << 1u) | (nb_rs_spread3(cz) << 2u);
+    vec3 u = d / length(d); // a zero or non-finite direction: NaN components, level 2
+    uint dir = nb_rs_dir_level(u.x) | (nb_rs_dir_level(u.y) << 2u) | (nb_rs_dir_level(u.z) << 4u);
+    return (dir << 9u) | nb_rs_spread3(cx) | (nb_rs_spread3(cy) << 1u) | (nb_rs_spread3(cz) << 2u);
 }
 
 // ---- Push constants (<= 128 bytes, the Vulkan minimum) --------------------------------------------
