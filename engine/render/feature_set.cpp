@@ -30,7 +30,7 @@ bool metallic_below_one(const Scene& scene, const Material& m) {
 
 std::string neural_rounds_text(const NeuralPlan& n, const char* traverse, const char* what) {
     std::string s;
-    s += "    passes/ray_sort.comp       rays in (direction octant, origin cell) order (--sort-rays; not camera rays)\n";
+    s += "    passes/ray_sort.comp       rays in (direction levels, origin cell) order (--sort-rays; not camera rays)\n";
     s += strfmt("    %-26s op 0: %s, queues (ray, leaf) pairs (indirect)\n", traverse, what);
     if (n.batched_rounds > 0) {
         s += strfmt("    repeat %u x (batched rounds):\n", n.batched_rounds);
@@ -230,14 +230,14 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
     if (n) {
         s += neural_rounds_text(*n, "passes/neural_traverse.comp", "closest hit through triangles and N-BVHs");
     } else {
-        s += "    passes/ray_sort.comp       bounces > 0: rays in (direction octant, origin cell) order (--sort-rays)\n";
+        s += "    passes/ray_sort.comp       bounces > 0: rays in (direction levels, origin cell) order (--sort-rays)\n";
         s += "    passes/traverse.comp       TLAS/BLAS closest hit (indirect)\n";
     }
     s += "    passes/shade.comp          BSDF, emission, light sampling, next ray (indirect)\n";
     if (f.has_lights()) {
         s += "    passes/queue_args.comp     shadow counter -> indirect dispatch arguments\n";
         if (n) s += neural_rounds_text(*n, "passes/neural_shadow.comp", "visibility through N-BVHs");
-        else s += "    passes/ray_sort.comp       shadow rays in (direction octant, origin cell) order (--sort-rays)\n";
+        else s += "    passes/ray_sort.comp       shadow rays in (direction levels, origin cell) order (--sort-rays)\n";
         s += "    passes/shadow.comp         any-hit visibility of light samples (indirect)\n";
     } else {
         s += "    (no shadow pass: nothing to sample by next-event estimation)\n";

@@ -46,7 +46,7 @@ struct RenderOptions {
     // Share of the GPU's device-local memory the wave's queues may take (wave_plan.h): a lone renderer a
     // quarter; `nbvh study`'s image renderers, which live together, split half of it between them.
     float wave_memory_share = 0.25f;
-    // Secondary and shadow rays are traced bin by bin of (direction octant, origin cell) (shared/
+    // Secondary and shadow rays are traced bin by bin of (direction level per axis, origin cell) (shared/
     // wavefront_gpu.h NB_RS_*, passes/ray_sort.comp; the hybrid's neural traversal op 0 too): same image,
     // coherent warps. --sort-rays.
     bool sort_rays = true;
