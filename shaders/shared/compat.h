@@ -24,6 +24,9 @@
 #define NB_INOUT(T) inout T
 #define NB_STATIC_ASSERT(cond, msg)
 #define NB_CONST const
+// A value that every shader computing it must get to the same bits (no contraction into fma, no
+// reassociation): e.g. a ray's sort key, computed by one pass to count and by another to scatter.
+#define NB_PRECISE precise
 
 #else // C++ and CUDA
 #define NB_CPP 1
@@ -53,6 +56,7 @@ typedef unsigned int uint;
 #define NB_INOUT(T) T&
 #define NB_STATIC_ASSERT(cond, msg) static_assert(cond, msg)
 #define NB_CONST constexpr
+#define NB_PRECISE
 #endif
 
 // Large finite sentinel for "no hit yet" (a literal: GLSL has no FLT_MAX).

@@ -141,20 +141,22 @@ NB_FN uint nb_rs_spread3(uint v) { return (v & 1u) | ((v & 2u) << 2u) | ((v & 4u
 // Level 0..3 of a unit direction's component c: [-1, -0.5), [-0.5, 0), [0, 0.5), [0.5, 1]; -0 and NaN
 // count as non-negative (level 2), so a level's top bit is the octant's sign bit inverted.
 NB_FN uint nb_rs_dir_level(float c) {
-    float t = (c + 1.0f) * 2.0f;
+    NB_PRECISE float t = (c + 1.0f) * 2.0f;
     if (t >= 0.0f) return uint(min(t, 3.0f));
     return c < 0.0f ? 0u : 2u; // below -1 by rounding: 0; NaN: 2
 }
 // Bin of a ray with origin o and direction d in a scene with bounds [lo, hi]: the direction's levels in
 // the top 6 bits (x lowest), the Morton code (x lowest) of the origin's cell of an 8^3 grid below.
+// shade.comp counts a ray in its bin and ray_sort.comp scatters it by the same key, so the arithmetic is
+// NB_PRECISE: both passes must get the same bin, whatever their compilers fuse.
 NB_FN uint nb_rs_key(vec3 o, vec3 d, vec3 lo, vec3 hi) {
-    vec3 ext = max(hi - lo, vec3(1e-30f));
-    vec3 f = (o - lo) / ext * 8.0f;
+    NB_PRECISE vec3 ext = max(hi - lo, vec3(1e-30f));
+    NB_PRECISE vec3 f = (o - lo) / ext * 8.0f;
     // NaN-safe clamps (a NaN coordinate goes to cell 0: defined, and the same in every pass).
     uint cx = uint(f.x >= 0.0f ? min(f.x, 7.0f) : 0.0f);
     uint cy = uint(f.y >= 0.0f ? min(f.y, 7.0f) : 0.0f);
     uint cz = uint(f.z >= 0.0f ? min(f.z, 7.0f) : 0.0f);
-    vec3 u = d / length(d); // a zero or non-finite direction: NaN components, level 2
+    NB_PRECISE vec3 u = d / length(d); // a zero or non-finite direction: NaN components, level 2
     uint dir = nb_rs_dir_level(u.x) | (nb_rs_dir_level(u.y) << 2u) | (nb_rs_dir_level(u.z) << 4u);
     return (dir << 9u) | nb_rs_spread3(cx) | (nb_rs_spread3(cy) << 1u) | (nb_rs_spread3(cz) << 2u);
 }
