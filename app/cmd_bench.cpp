@@ -160,9 +160,7 @@ void add_bench_command(CLI::App& app, const std::string& command_line) {
     cmd->add_option("scene", args->scene, "glTF/GLB file, or 'default' for the built-in scene")->required();
     cmd->add_option("--model", args->model, "N-BVH model (.nbvh) of the scene's neural asset")->required();
     add_render_option_flags(cmd, args->options);
-    cmd->add_option("--device", args->device,
-                    "Vulkan device: auto, gpu, gpu:N (the N-th GPU in PCI order, nvidia-smi's number) "
-                    "or cpu (lavapipe)");
+    cmd->add_option("--device", args->device, vk::DEVICE_OPTION_HELP);
     cmd->add_option("--repeat", args->repeat, "timed renders per configuration (the median is reported)")
         ->check(CLI::Range(1u, 1000u));
     cmd->add_option("--json", args->json, "write the table (and per-pass GPU times) as JSON");

@@ -257,9 +257,7 @@ void add_bench_features_command(CLI::App& app, const std::string& command_line) 
     cmd->add_option("--seed", args->options.seed, "random seed");
     cmd->add_option("--repeat", args->repeat, "timed frames per configuration (the median is reported)")
         ->check(CLI::Range(1u, 1000u));
-    cmd->add_option("--device", args->device,
-                    "Vulkan device: auto, gpu, gpu:N (the N-th GPU in PCI order, nvidia-smi's number) "
-                    "or cpu (lavapipe)");
+    cmd->add_option("--device", args->device, vk::DEVICE_OPTION_HELP);
     cmd->add_option("--env", args->env, "environment map (.hdr or .exr), or 'none' (the scene's lights only)");
     cmd->add_option("--json", args->json, "write every figure (and the frames' GPU times) as JSON");
     cmd->add_option("--markdown", args->markdown, "write the table as markdown");

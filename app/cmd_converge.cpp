@@ -220,9 +220,7 @@ void add_converge_command(CLI::App& app, const std::string& command_line) {
         ->check(CLI::Range(1u, 1u << 20));
     cmd->add_option("--lod", args->lod, "N-BVH level of detail of camera rays (0 = finest)");
     cmd->add_option("--secondary-lod", args->secondary_lod, "LoD after the first hit: coarsest, same or 0..7");
-    cmd->add_option("--device", args->device,
-                    "Vulkan device: auto, gpu, gpu:N (the N-th GPU in PCI order, nvidia-smi's number) "
-                    "or cpu (lavapipe)");
+    cmd->add_option("--device", args->device, vk::DEVICE_OPTION_HELP);
     cmd->add_option("--json", args->json, "write the table as JSON (device, commit, command line inside)");
     cmd->add_option("--csv", args->csv, "write the table as CSV");
     cmd->add_option("--neural-path", args->neural_path, "MLP implementation: auto, scalar or coopmat");

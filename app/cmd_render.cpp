@@ -218,9 +218,7 @@ void add_render_command(CLI::App& app, const std::string& command_line) {
     cmd->add_option("scene", args->scene, "glTF/GLB file, or 'default' for the built-in scene")->required();
     cmd->add_option("--out", args->out, "output image: .png (tone-mapped sRGB) or .exr (linear)");
     add_render_option_flags(cmd, args->options); // --width --height --spp --max-depth --seed, neural constants
-    cmd->add_option("--device", args->device,
-                    "Vulkan device: auto, gpu, gpu:N (the N-th GPU in PCI order, nvidia-smi's number) "
-                    "or cpu (lavapipe)");
+    cmd->add_option("--device", args->device, vk::DEVICE_OPTION_HELP);
     cmd->add_option("--camera", args->camera, "eye_x,eye_y,eye_z,target_x,target_y,target_z,fov_deg");
     cmd->add_option("--env", args->env,
                     "environment map (.hdr or .exr, equirectangular), or 'none' for the scene's own emitters and "

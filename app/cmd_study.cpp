@@ -11,6 +11,7 @@
 #include "app/commands.h"
 #include "app/render_args.h"
 #include "app/study/study_runner.h"
+#include "engine/vk/context.h"
 
 namespace nbvh::app {
 
@@ -60,10 +61,8 @@ void add_study_command(CLI::App& app, const std::string& command_line) {
         ->check(CLI::Range(1u, 16384u));
     cmd->add_option("--time-height", o->time_height, "height of the timed frames (default: --height)")
         ->check(CLI::Range(1u, 16384u));
-    cmd->add_option(
-        "--device", o->device,
-        "Vulkan device: auto, gpu, gpu:N (the N-th GPU in PCI order, nvidia-smi's number; the CUDA "
-        "trainer then uses the same GPU) or cpu (lavapipe)");
+    cmd->add_option("--device", o->device,
+                    std::string(vk::DEVICE_OPTION_HELP) + "; with gpu:N the CUDA trainer uses the same GPU");
     cmd->add_option("--env", o->env, "environment map (.hdr or .exr), or 'none' (the scene's lights only)");
     cmd->add_option("--env-rotation", o->env_rotation, "rotate the environment about +y by this many degrees")
         ->check(CLI::Range(-3600.0f, 3600.0f));

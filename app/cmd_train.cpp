@@ -70,8 +70,7 @@ std::string training_gpu_uuid(const std::string& device, const std::string& back
         throw Error("--device " + device +
                     " picks the GPU that CUDA trains on; it does not go with --backend cpu");
     vk::ContextOptions copt;
-    copt.device = spec.choice;
-    copt.gpu_index = spec.gpu_index;
+    copt.set_device(spec);
     const vk::Context ctx(copt); // throws the one-line error of a GPU number beyond the last
     return ctx.features().device_uuid;
 }

@@ -9,6 +9,7 @@
 #include "app/commands.h"
 #include "app/render_args.h"
 #include "app/viewer/viewer.h"
+#include "engine/vk/context.h"
 
 namespace nbvh::app {
 
@@ -24,8 +25,8 @@ void add_view_command(CLI::App& app) {
     cmd->add_option("--width", args->width, "window width in pixels")->check(CLI::Range(16u, 16384u));
     cmd->add_option("--height", args->height, "window height in pixels")->check(CLI::Range(16u, 16384u));
     cmd->add_option("--device", args->device,
-                    "Vulkan device: auto, gpu, gpu:N (the N-th GPU in PCI order, nvidia-smi's number; live "
-                    "CUDA training then uses the same GPU) or cpu (lavapipe)");
+                    std::string(vk::DEVICE_OPTION_HELP) +
+                        "; with gpu:N live CUDA training uses the same GPU");
     cmd->add_option("--max-depth", args->max_depth, "maximum path segments")->check(CLI::Range(1u, 256u));
     cmd->add_option("--lod", args->lod, "initial N-BVH level of detail (0 = finest)");
     auto secondary_lod = std::make_shared<std::string>("coarsest");

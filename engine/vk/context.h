@@ -47,15 +47,18 @@ struct DeviceSpec {
     int gpu_index = -1; // gpu:N; -1: the best GPU
 };
 DeviceSpec parse_device_spec(std::string_view text); // auto|gpu|gpu:N|cpu; throws Error on anything else
+// The --device help of every command that takes one.
+inline constexpr const char* DEVICE_OPTION_HELP =
+    "Vulkan device: auto, gpu, gpu:N (the N-th GPU in PCI order, nvidia-smi's number) or cpu (lavapipe)";
 
 struct ContextOptions {
     DeviceChoice device = DeviceChoice::automatic;
     int gpu_index = -1; // with DeviceChoice::gpu: the N-th GPU in PCI bus order (-1: the best one)
-    void set_device(std::string_view text) { // from a --device argument (parse_device_spec)
-        const DeviceSpec s = parse_device_spec(text);
+    void set_device(const DeviceSpec& s) {
         device = s.choice;
         gpu_index = s.gpu_index;
     }
+    void set_device(std::string_view text) { set_device(parse_device_spec(text)); } // a --device argument
     // Khronos validation layer + debug messenger. Also switched on by NBVH_VALIDATION=1 in the
     // environment (NBVH_VALIDATION=0 switches it off). Debug builds default to on.
 #ifdef NDEBUG

@@ -97,7 +97,7 @@ int main(int argc, char** argv) try {
         else throw Error("unknown option " + a);
     }
     vk::ContextOptions o;
-    o.device = vk::parse_device_choice(device);
+    o.set_device(device); // auto, gpu, gpu:N or cpu, as the CLI
     vk::Context ctx(o);
     const vk::DeviceFeatures& dev = ctx.features();
     std::printf("device: %s (%s %s)\n", dev.device_name.c_str(), dev.driver_name.c_str(), dev.driver_info.c_str());

@@ -89,7 +89,7 @@ int main(int argc, char** argv) try {
     const Environment env = scene.environment.empty() ? default_sky() : scene.environment;
     const Camera camera = scene.has_camera ? scene.camera : auto_frame(scene, float(a.width) / float(a.height));
     vk::ContextOptions copt;
-    copt.device = vk::parse_device_choice(a.device);
+    copt.set_device(a.device); // auto, gpu, gpu:N or cpu, as the CLI
     vk::Context ctx(copt);
 
     render::RenderOptions o;
