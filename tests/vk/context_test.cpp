@@ -89,6 +89,7 @@ TEST(VkContext, DeviceSpecParsing) {
         EXPECT_THROW(parse_device_spec(bad), nbvh::Error) << bad;
     try { // every unknown word is told every form, gpu:N included
         parse_device_spec("gpu0");
+        ADD_FAILURE() << "gpu0 was accepted";
     } catch (const nbvh::Error& e) {
         EXPECT_NE(std::string(e.what()).find("gpu:N"), std::string::npos) << e.what();
     }
