@@ -41,7 +41,7 @@ NeuralGpuBytes neural_gpu_bytes(const NeuralModel& model) {
         const uint64_t end = (l + 1) * assets < roots.size() ? roots[(l + 1) * assets] : nodes.size();
         b.lod_nodes.push_back((end - first) * sizeof(GpuBvhNode));
     }
-    b.node_bounds = uint64_t(model.nodes.size()) * 2 * sizeof(glm::vec3);
+    b.node_bounds = uint64_t(model.nodes.size()) * NB_NBVH_BOUNDS_WORDS * sizeof(uint32_t);
     b.occupancy = uint64_t(model.occupancy.size()) * sizeof(uint32_t); // after the bounds, same buffer
     b.materials = uint64_t(model.node_materials.size() + model.material_fits.size()) * sizeof(uint32_t); // after the masks, same buffer
     b.assets = uint64_t(model.assets.size()) * sizeof(GpuNeuralAsset);

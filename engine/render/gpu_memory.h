@@ -24,7 +24,7 @@ struct NeuralGpuBytes {
     uint64_t levels = 0, grid = 0, mlp = 0, mlp_transposed = 0; // the transposed copy feeds coopmat kernels
     uint64_t nodes = 0;              // N-BVH nodes of every LoD and asset (GpuBvhNode)
     std::vector<uint64_t> lod_nodes; // ... of each LoD alone
-    uint64_t node_bounds = 0;        // two vec3 per N-BVH node
+    uint64_t node_bounds = 0;        // NB_NBVH_BOUNDS_WORDS per N-BVH node (two 16-byte words)
     uint64_t occupancy = 0;          // NB_OCC_WORDS words per N-BVH node (0: the model has no masks)
     uint64_t materials = 0;          // one word per N-BVH node (0: the model has no node materials)
     uint64_t assets = 0, params = 0; // GpuNeuralAsset table, GpuNeuralParams

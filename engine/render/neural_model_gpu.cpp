@@ -140,15 +140,18 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
     pack_lod_nodes(model, nodes, roots_);
     asset_count_ = uint32_t(model.assets.size());
     nodes_ = vk::make_buffer(ctx, nodes, "nbvh nodes");
-    // vec3 lo, vec3 hi per node as words, then the occupancy masks (shared/neural_occupancy.h) and the
-    // node materials (node_materials.h) in the same buffer (the set has no binding to spare: lavapipe
-    // allows 32 storage buffers per stage); models without them have none.
+    // (lo, 0), (hi, 0) per node as words (NB_NBVH_BOUNDS_WORDS: two 16-byte loads, neural_bindings.glsl),
+    // then the occupancy masks (shared/neural_occupancy.h) and the node materials (node_materials.h) in
+    // the same buffer (the set has no binding to spare: lavapipe allows 32 storage buffers per stage);
+    // models without them have none.
     std::vector<uint32_t> words;
-    words.reserve(model.nodes.size() * 6 + model.occupancy.size() + model.node_materials.size() +
-                  model.material_fits.size());
+    words.reserve(model.nodes.size() * NB_NBVH_BOUNDS_WORDS + model.occupancy.size() +
+                  model.node_materials.size() + model.material_fits.size());
     for (const NbvhNode& n : model.nodes)
-        for (const glm::vec3& v : {n.bounds.lo, n.bounds.hi})
+        for (const glm::vec3& v : {n.bounds.lo, n.bounds.hi}) {
             for (int k = 0; k < 3; ++k) words.push_back(floatBitsToUint(v[k]));
+            words.push_back(0u);
+        }
     if (model.occupancy.size() == model.nodes.size() * NB_OCC_WORDS) {
         occupancy_offset_ = uint32_t(words.size());
         words.insert(words.end(), model.occupancy.begin(), model.occupancy.end());

@@ -7,6 +7,8 @@
 #include "shaders/shared/neural_gpu.h"
 #include "shaders/shared/wavefront_gpu.h"
 
+static_assert(NB_NL_MAX_LEAVES_PER_ROUND <= 15u, "a pair's group count is packed in 4 bits (GpuPendingLeaf)");
+
 namespace nbvh::render {
 
 WaveLimits wave_limits(const vk::DeviceFeatures& dev) {
@@ -49,11 +51,13 @@ WavePlan plan_wave(uint64_t pixels, const RenderOptions& o, const WaveLimits& li
         const uint64_t k = effective_leaves_per_round(o.neural);
         cap = std::min<uint64_t>(cap, b / (2ull * sizeof(GpuNeuralRayState)));
         cap = std::min<uint64_t>(cap, b / (k * sizeof(GpuPendingLeaf))); // each half of the pending queue
+        // A pair's ray (path slot, or capacity + shadow slot) is packed in NB_PAIR_RAY_BITS bits.
+        cap = std::min<uint64_t>(cap, (uint64_t(NB_PAIR_RAY_MASK) + 1u) / 2u);
         // The query pass is dispatched indirectly over up to k pairs per ray (not checked on the host).
         if (limits.max_workgroups_x) cap = std::min<uint64_t>(cap, uint64_t(limits.max_workgroups_x) * NB_NEURAL_GROUP / k);
     }
     // The queues take at most wave_memory_share of the GPU's memory (a quarter by default; 196 bytes per
-    // classical path, ~530 per hybrid one with 2 leaves per round: a quarter of an 8 GiB card holds
+    // classical path, ~515 per hybrid one with 2 leaves per round: a quarter of an 8 GiB card holds
     // ~11M / ~4M paths).
     if (limits.device_local_bytes)
         cap = std::min<uint64_t>(cap, uint64_t(double(limits.device_local_bytes) * o.wave_memory_share) /

@@ -40,7 +40,7 @@ struct RenderOptions {
     // its memory, the dispatch limits) and the statistics counters; a wave of several samples of every
     // pixel holds at most 32M paths (engine/render/wave_plan.h). 32M: sixteen samples of a 1080p frame,
     // so the deep bounces' latency-bound passes are paid once per sixteen samples (results/perf/
-    // frame_depths.md, README.md). Queue memory at 32M: ~6.5 GB classical, ~17.7 GB hybrid (2 leaves per
+    // frame_depths.md, README.md). Queue memory at 32M: ~6.5 GB classical, ~17.2 GB hybrid (2 leaves per
     // round), bounded by a quarter of the GPU's memory.
     uint32_t max_wave_pixels = 1u << 25;
     // Share of the GPU's device-local memory the wave's queues may take (wave_plan.h): a lone renderer a

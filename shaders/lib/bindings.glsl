@@ -55,10 +55,11 @@ layout(set = 0, binding = NB_BIND_SAMPLE_RADIANCE, scalar) buffer SampleRadiance
 // Running sum over samples, per image pixel (rgb sum, a = samples accumulated).
 layout(set = 0, binding = NB_BIND_FILM, scalar) buffer FilmBuffer { vec4 film[]; };
 // The pending (ray, leaf) queue's two halves, one binding each (each may need most of one buffer's
-// range: a 32M-path hybrid wave holds 2 x 2 x 52 bytes of pairs per path); slots address both, half 1
-// from its half size on (lib/neural_bindings.glsl nb_nl_pending_index).
-layout(set = 0, binding = NB_BIND_PENDING_LEAVES, scalar) buffer PendingLeafBuffer { GpuPendingLeaf pending_leaves[]; };
-layout(set = 0, binding = NB_BIND_PENDING_LEAVES_1, scalar) buffer PendingLeafBuffer1 { GpuPendingLeaf pending_leaves_1[]; };
+// range: a 32M-path hybrid wave holds 2 x 2 x 48 bytes of pairs per path); slots address both, half 1
+// from its half size on (lib/neural_bindings.glsl nb_nl_pending_index). A pair (GpuPendingLeaf) is 3
+// consecutive 16-byte words here, read and written by lib/neural_bindings.glsl nb_pending_*.
+layout(set = 0, binding = NB_BIND_PENDING_LEAVES, std430) buffer PendingLeafBuffer { uvec4 pending_leaves[]; };
+layout(set = 0, binding = NB_BIND_PENDING_LEAVES_1, std430) buffer PendingLeafBuffer1 { uvec4 pending_leaves_1[]; };
 layout(set = 0, binding = NB_BIND_OUTPUT, scalar) buffer OutputBuffer { vec4 output_pixels[]; };
 // Ray order of the traversal and shadow passes (shared/wavefront_gpu.h NB_RS_*).
 layout(set = 0, binding = NB_BIND_RAY_SORT, std430) buffer RaySortBuffer {

@@ -17,8 +17,8 @@ layout(set = 0, binding = NB_BIND_NEURAL_MLP_T, scalar) readonly buffer NeuralMl
 layout(set = 0, binding = NB_BIND_NEURAL_MLP, scalar) readonly buffer NeuralMlpBuffer { uint neural_mlp[]; };
 #endif
 layout(set = 0, binding = NB_BIND_NBVH_NODES, std430) readonly buffer NbvhNodeBuffer { GpuBvhNode nbvh_nodes[]; };
-// Object-space bounds of every N-BVH node: lo at 2i, hi at 2i + 1.
-layout(set = 0, binding = NB_BIND_NBVH_BOUNDS, scalar) readonly buffer NbvhBoundsBuffer { vec3 nbvh_bounds[]; };
+// Object-space bounds of every N-BVH node: (lo, 0) at 2i, (hi, 0) at 2i + 1 (NB_NBVH_BOUNDS_WORDS).
+layout(set = 0, binding = NB_BIND_NBVH_BOUNDS, std430) readonly buffer NbvhBoundsBuffer { vec4 nbvh_bounds[]; };
 // The same buffer as words: node i's occupancy mask (shared/neural_occupancy.h) is NB_OCC_WORDS words
 // from neural_params.occupancy + NB_OCC_WORDS * i.
 layout(set = 0, binding = NB_BIND_NBVH_BOUNDS, std430) readonly buffer NbvhBoundsWords { uint nbvh_bounds_words[]; };
@@ -31,52 +31,70 @@ layout(set = 0, binding = NB_BIND_NEURAL_COUNTERS, scalar) coherent buffer Neura
 // own binding: half 1's slots start at the half size).
 uint nb_nl_half_size() { return ray_capacity() * neural_params.leaves_per_round; }
 uint nb_nl_pending_index(uint half_, uint k) { return half_ * nb_nl_half_size() + k; }
-// Whole records are copied field by field: glslang emits an invalid whole-struct store between the two
-// blocks' copies of the struct type (spirv-opt: "OpStore ... type does not match").
-#define NB_PENDING_COPY(DST, SRC)                                                                    \
-    DST.ray = SRC.ray;                                                                                \
-    DST.instance = SRC.instance;                                                                      \
-    DST.leaf = SRC.leaf;                                                                              \
-    DST.t_enter = SRC.t_enter;                                                                        \
-    DST.t_exit = SRC.t_exit;                                                                          \
-    DST.group = SRC.group;                                                                            \
-    DST.t = SRC.t;                                                                                    \
-    DST.a = SRC.a;                                                                                    \
-    DST.b = SRC.b;
-GpuPendingLeaf nb_pending_load(uint slot) {
+// A pending pair as the passes use it (stored as shared/wavefront_gpu.h GpuPendingLeaf: `ray` and
+// `group` packed in one word, the record 3 uvec4 of the pending bindings).
+struct NbPendingPair {
+    uint ray;       // path-ray slot, or ray capacity + shadow-ray slot
+    uint instance;
+    uint leaf;
+    float t_enter;
+    float t_exit;
+    uint group;     // count (the group's first pair; 0 for the others) | NB_RAY_BACKFACE_BIT
+    float t;        // queued: the ray's bound; answered: the hit (NB_INF: none)
+    vec3 a;         // queued: world origin; answered: normal
+    vec3 b;         // queued: world direction; answered: albedo
+};
+uvec4 nb_pending_word(uint slot, uint w) {
     uint hs = nb_nl_half_size();
-    GpuPendingLeaf pl;
-    if (slot < hs) {
-        NB_PENDING_COPY(pl, pending_leaves[slot])
-    } else {
-        NB_PENDING_COPY(pl, pending_leaves_1[slot - hs])
-    }
+    if (slot < hs) return pending_leaves[3u * slot + w];
+    return pending_leaves_1[3u * (slot - hs) + w];
+}
+void nb_pending_set_word(uint slot, uint w, uvec4 v) {
+    uint hs = nb_nl_half_size();
+    if (slot < hs)
+        pending_leaves[3u * slot + w] = v;
+    else
+        pending_leaves_1[3u * (slot - hs) + w] = v;
+}
+NbPendingPair nb_pending_load(uint slot) {
+    uvec4 q0 = nb_pending_word(slot, 0u), q1 = nb_pending_word(slot, 1u), q2 = nb_pending_word(slot, 2u);
+    NbPendingPair pl;
+    pl.ray = nb_pair_ray(q0.x);
+    pl.group = nb_pair_flagged_group(q0.x);
+    pl.instance = q0.y;
+    pl.leaf = q0.z;
+    pl.t_enter = uintBitsToFloat(q0.w);
+    pl.t_exit = uintBitsToFloat(q1.x);
+    pl.t = uintBitsToFloat(q1.y);
+    pl.a = uintBitsToFloat(uvec3(q1.zw, q2.x));
+    pl.b = uintBitsToFloat(q2.yzw);
     return pl;
 }
-void nb_pending_store(uint slot, GpuPendingLeaf pl) {
-    uint hs = nb_nl_half_size();
-    if (slot < hs) {
-        NB_PENDING_COPY(pending_leaves[slot], pl)
-    } else {
-        NB_PENDING_COPY(pending_leaves_1[slot - hs], pl)
-    }
+void nb_pending_store(uint slot, NbPendingPair pl) {
+    nb_pending_set_word(slot, 0u, uvec4(nb_pair_pack_ray_group(pl.ray, pl.group), pl.instance, pl.leaf,
+                                        floatBitsToUint(pl.t_enter)));
+    nb_pending_set_word(slot, 1u, uvec4(floatBitsToUint(pl.t_exit), floatBitsToUint(pl.t), floatBitsToUint(pl.a.xy)));
+    nb_pending_set_word(slot, 2u, uvec4(floatBitsToUint(pl.a.z), floatBitsToUint(pl.b)));
 }
 // The query pass's result of a pair. A miss (t NB_INF) stores t only: the resumed traversal takes a
 // pair's normal and albedo only from a hit in front of its best one (nb_nl_take_hit).
 void nb_pending_set_hit(uint slot, float t, vec3 normal, vec3 albedo) {
     uint hs = nb_nl_half_size();
     bool hit = t < NB_INF;
+    uint i = 3u * (slot < hs ? slot : slot - hs);
     if (slot < hs) {
-        pending_leaves[slot].t = t;
         if (hit) {
-            pending_leaves[slot].a = normal;
-            pending_leaves[slot].b = albedo;
+            pending_leaves[i + 1u].yzw = floatBitsToUint(vec3(t, normal.xy));
+            pending_leaves[i + 2u] = floatBitsToUint(vec4(normal.z, albedo));
+        } else {
+            pending_leaves[i + 1u].y = floatBitsToUint(t);
         }
     } else {
-        pending_leaves_1[slot - hs].t = t;
         if (hit) {
-            pending_leaves_1[slot - hs].a = normal;
-            pending_leaves_1[slot - hs].b = albedo;
+            pending_leaves_1[i + 1u].yzw = floatBitsToUint(vec3(t, normal.xy));
+            pending_leaves_1[i + 2u] = floatBitsToUint(vec4(normal.z, albedo));
+        } else {
+            pending_leaves_1[i + 1u].y = floatBitsToUint(t);
         }
     }
 }

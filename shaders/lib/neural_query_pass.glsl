@@ -9,7 +9,7 @@
 struct NbPendingQuery {
     bool valid;
     uint slot; // index in pending_leaves
-    GpuPendingLeaf pl;
+    NbPendingPair pl;
     vec3 org;  // object space
     vec3 dir;
 };

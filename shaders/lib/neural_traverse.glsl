@@ -61,7 +61,7 @@ void nb_neural_leaf(uint first, uint count) {
     for (uint k = 0u; k < count; ++k) {
         uint node = first + k;
         float te, tx;
-        vec3 lo = nbvh_bounds[2u * node], hi = nbvh_bounds[2u * node + 1u];
+        vec3 lo = nbvh_bounds[2u * node].xyz, hi = nbvh_bounds[2u * node + 1u].xyz;
         if (!nb_neural_leaf_interval(g_obj_org, g_nl_inv_dir, lo, hi, te, tx)) continue;
         if (!(tx > g_nl_ray_tmin)) continue; // the leaf lies behind the ray's start
         float key = max(te, g_nl_ray_tmin);
@@ -155,7 +155,7 @@ bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, vec3 org, 
                                     : ray_load1(pc.in_queue, NB_RAY_DEPTH, state_index)) & NB_RAY_BACKFACE_BIT;
     uint k = atomicAdd(counters.pending_count, n);
     for (uint j = 0u; j < n; ++j) {
-        GpuPendingLeaf pl;
+        NbPendingPair pl;
         pl.ray = state_index;
         pl.instance = g_nl_cand_inst[j];
         pl.leaf = g_nl_cand_leaf[j];
@@ -204,7 +204,7 @@ bool nb_nl_is_pending(uint status) { return status == NB_NRAY_PENDING || status 
 // The resumed traversal of a ray: the results of its `group` pairs from pending slot `slot` on.
 void nb_nl_reduce_group(uint slot, uint group, inout GpuNeuralRayState st) {
     for (uint j = 0u; j < group; ++j) {
-        GpuPendingLeaf pl = nb_pending_load(slot + j);
+        NbPendingPair pl = nb_pending_load(slot + j);
         nb_nl_take_hit(st, pl.t, pl.a, pl.b, pl.instance, pl.leaf); // the answered pair
     }
     st.status = NB_NRAY_TRACE;

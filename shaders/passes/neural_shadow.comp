@@ -24,7 +24,7 @@ void main() {
         uint k = gl_GlobalInvocationID.x;
         if (k >= neural_counters.pending_active) return;
         uint slot = nb_nl_pending_index(half_ ^ 1u, k);
-        GpuPendingLeaf pl = nb_pending_load(slot);
+        NbPendingPair pl = nb_pending_load(slot);
         if (nb_pair_group(pl.group) == 0u) return; // the first pair of the ray's group resumes it
         i = pl.ray - cap;
         st = neural_state[cap + i];

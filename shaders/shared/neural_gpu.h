@@ -154,7 +154,8 @@ struct GpuNeuralParams {
     uint max_rounds;      // leaves queried per ray at most (then the best hit so far is kept)
     uint leaves_per_round; // 1..NB_NL_MAX_LEAVES_PER_ROUND leaves queued per ray per traversal round
     // Occupancy masks (shared/neural_occupancy.h): their first word in the node-bounds buffer
-    // (NB_BIND_NBVH_BOUNDS seen as words, after the 6 words per node of the bounds), 0 = none or off.
+    // (NB_BIND_NBVH_BOUNDS seen as words, after the NB_NBVH_BOUNDS_WORDS per node of the bounds), 0 =
+    // none or off.
     uint occupancy;
     // Per-node materials (engine/neural/node_materials.h, nb_pack_node_material): their first word in
     // the same buffer, one word per node; 0 = none or off (hits take their asset's metallic/roughness).
@@ -221,6 +222,9 @@ NB_FN void nb_add_u64(NB_INOUT(uint) lo, NB_INOUT(uint) hi, uint n) {
 #define NB_BIND_NEURAL_MLP 22u
 #define NB_BIND_NBVH_NODES 23u
 #define NB_BIND_NBVH_BOUNDS 24u
+// Words per N-BVH node at the start of that buffer: lo xyz, 0, hi xyz, 0 (two 16-byte loads; packed as
+// 6 words, the box took six 4-byte loads: the buffer is read per leaf a ray walks).
+#define NB_NBVH_BOUNDS_WORDS 8u
 #define NB_BIND_NEURAL_STATE 25u
 #define NB_BIND_NEURAL_PARAMS 26u
 #define NB_BIND_NEURAL_COUNTERS 27u

@@ -61,16 +61,19 @@ NB_FN uint nb_shadow_word(uint field, uint capacity, uint index, uint components
 }
 
 // ---- Pending (ray, neural leaf) pairs (neural issue; allocated with a minimal size until then) ----
+// A pair as stored: 12 words, so that the passes move it as three 16-byte words (lib/neural_bindings.glsl;
+// 13 words at a 52-byte stride took 13 four-byte accesses each way).
 struct GpuPendingLeaf {
-    uint ray;       // slot in the current path-ray queue
+    // The ray and its group, packed (nb_pair_pack_ray_group): bits 0-26 the ray (a slot in the current
+    // path-ray queue, or ray capacity + a shadow-ray slot); bits 27-30 the group: a ray queues up to
+    // GpuNeuralParams.leaves_per_round pairs per round, contiguously, in key order, and the first one
+    // holds their count (its resumed traversal reduces them), the others 0 (nb_pair_group); bit 31
+    // (NB_RAY_BACKFACE_BIT) set: the ray's query skips back-facing hits (every pair of the ray).
+    uint ray_group;
     uint instance;  // the neural instance
     uint leaf;      // N-BVH leaf index
     float t_enter;  // leaf interval along the ray (world t)
     float t_exit;
-    // A ray queues up to GpuNeuralParams.leaves_per_round pairs per round, contiguously, in key order:
-    // the first one holds their count (its resumed traversal reduces them), the others 0 (nb_pair_group);
-    // bit 31 (NB_RAY_BACKFACE_BIT) set: the ray's query skips back-facing hits (every pair of the ray).
-    uint group;
     // The last 7 words serve two phases. Queued (by the traversal): the query's inputs, so that the
     // query pass reads them here, in queue order, instead of from the ray queues at scattered slots:
     // t = the ray's bound (path rays: their tmin, NB_RAY_T_RESUME; shadow rays: their tmax), a / b = its
@@ -80,7 +83,18 @@ struct GpuPendingLeaf {
     vec3 a;
     vec3 b;
 };
-NB_STATIC_ASSERT(sizeof(GpuPendingLeaf) == 52, "GpuPendingLeaf layout");
+NB_STATIC_ASSERT(sizeof(GpuPendingLeaf) == 48, "GpuPendingLeaf layout");
+#define NB_PAIR_RAY_BITS 27u
+#define NB_PAIR_RAY_MASK ((1u << NB_PAIR_RAY_BITS) - 1u) // rays < 2^27: the wave plan bounds 2 x capacity
+// `group`: the group count (< 16), with NB_RAY_BACKFACE_BIT where the ray skips back faces.
+NB_FN uint nb_pair_pack_ray_group(uint ray, uint group) {
+    return (ray & NB_PAIR_RAY_MASK) | ((group & 0xFu) << NB_PAIR_RAY_BITS) | (group & NB_RAY_BACKFACE_BIT);
+}
+NB_FN uint nb_pair_ray(uint ray_group) { return ray_group & NB_PAIR_RAY_MASK; }
+// The group count with the back-face bit (as packed).
+NB_FN uint nb_pair_flagged_group(uint ray_group) {
+    return ((ray_group >> NB_PAIR_RAY_BITS) & 0xFu) | (ray_group & NB_RAY_BACKFACE_BIT);
+}
 NB_FN uint nb_pair_group(uint group) { return group & ~NB_RAY_BACKFACE_BIT; }
 
 // ---- Queue counters and indirect arguments -------------------------------------------------------

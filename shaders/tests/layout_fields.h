@@ -78,7 +78,8 @@
     F(light_count) F(light_total_power) F(max_depth) F(rr_start_depth) F(seed) F(spp)             \
     F(wave_capacity) F(ray_epsilon) F(instance_count) F(punctual_count) F(sort_rays)  \
     F(path_sampler) F(pad0) F(pad1) F(pad2)
-#define NB_LAYOUT_FIELDS_GpuPendingLeaf(F) F(ray) F(instance) F(leaf) F(t_enter) F(t_exit) F(group) F(t) F(a) F(b)
+#define NB_LAYOUT_FIELDS_GpuPendingLeaf(F)                                                                   \
+    F(ray_group) F(instance) F(leaf) F(t_enter) F(t_exit) F(t) F(a) F(b)
 #define NB_LAYOUT_FIELDS_GpuDispatchArgs(F) F(x) F(y) F(z)
 #define NB_LAYOUT_FIELDS_GpuQueueCounters(F)                                                      \
     F(ray_dispatch.x) F(ray_dispatch.y) F(ray_dispatch.z)                                         \
