@@ -22,10 +22,40 @@ layout(set = 0, binding = NB_BIND_NBVH_BOUNDS, std430) readonly buffer NbvhBound
 // The same buffer as words: node i's occupancy mask (shared/neural_occupancy.h) is NB_OCC_WORDS words
 // from neural_params.occupancy + NB_OCC_WORDS * i.
 layout(set = 0, binding = NB_BIND_NBVH_BOUNDS, std430) readonly buffer NbvhBoundsWords { uint nbvh_bounds_words[]; };
-layout(set = 0, binding = NB_BIND_NEURAL_STATE, scalar) buffer NeuralStateBuffer { GpuNeuralRayState neural_state[]; };
+// Per-ray neural state (GpuNeuralRayState, 64 bytes): 4 consecutive 16-byte words per ray, read and
+// written whole by nb_state_load / nb_state_store below (a scalar-layout struct copy took 16 four-byte
+// accesses each way).
+layout(set = 0, binding = NB_BIND_NEURAL_STATE, std430) buffer NeuralStateBuffer { uvec4 neural_state[]; };
 layout(set = 0, binding = NB_BIND_NEURAL_PARAMS, scalar) readonly buffer NeuralParamsBuffer { GpuNeuralParams neural_params; };
 layout(set = 0, binding = NB_BIND_NEURAL_ASSETS, scalar) readonly buffer NeuralAssetBuffer { GpuNeuralAsset neural_assets[]; };
 layout(set = 0, binding = NB_BIND_NEURAL_COUNTERS, scalar) coherent buffer NeuralCountersBuffer { GpuNeuralCounters neural_counters; };
+
+GpuNeuralRayState nb_state_load(uint i) {
+    uvec4 q0 = neural_state[4u * i], q1 = neural_state[4u * i + 1u];
+    uvec4 q2 = neural_state[4u * i + 2u], q3 = neural_state[4u * i + 3u];
+    GpuNeuralRayState st;
+    st.normal = uintBitsToFloat(q0.xyz);
+    st.best_t = uintBitsToFloat(q0.w);
+    st.albedo_rg = q1.x;
+    st.albedo_b = q1.y;
+    st.hit_leaf = q1.z;
+    st.instance = q1.w;
+    st.key_t = uintBitsToFloat(q2.x);
+    st.key_instance = q2.y;
+    st.key_leaf = q2.z;
+    st.status = q2.w;
+    st.tri_t = uintBitsToFloat(q3.x);
+    st.tri_instance = q3.y;
+    st.tri_triangle = q3.z;
+    st.rounds = q3.w;
+    return st;
+}
+void nb_state_store(uint i, GpuNeuralRayState st) {
+    neural_state[4u * i] = uvec4(floatBitsToUint(st.normal), floatBitsToUint(st.best_t));
+    neural_state[4u * i + 1u] = uvec4(st.albedo_rg, st.albedo_b, st.hit_leaf, st.instance);
+    neural_state[4u * i + 2u] = uvec4(floatBitsToUint(st.key_t), st.key_instance, st.key_leaf, st.status);
+    neural_state[4u * i + 3u] = uvec4(floatBitsToUint(st.tri_t), st.tri_instance, st.tri_triangle, st.rounds);
+}
 
 // Slot k of half `half_` of the pending queue (each half holds leaves_per_round pairs per ray, in its
 // own binding: half 1's slots start at the half size).

@@ -16,7 +16,7 @@
 // ps: the path's numbers; the spread's sign is its NB_PAIR_MATERIAL bit (drawn only where the spread is
 // on, and without moving the path's later numbers: nb_path_bit).
 Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t, PathSampler ps) {
-    GpuNeuralRayState st = neural_state[ray];
+    GpuNeuralRayState st = nb_state_load(ray);
     Surface s;
     GpuNeuralAsset asset = neural_assets[instances[st.instance].blas_root];
     GpuMaterial m = materials[asset.material];
@@ -53,7 +53,7 @@ Surface nb_make_neural_surface(uint ray, vec3 ray_org, vec3 ray_dir, float t, Pa
 // backface_escape and its predicted normal faces along the incoming ray (shared/neural_query.h
 // nb_backface_skip).
 bool nb_neural_escapes(uint ray, vec3 ray_dir) {
-    GpuNeuralRayState st = neural_state[ray];
+    GpuNeuralRayState st = nb_state_load(ray);
     return neural_assets[instances[st.instance].blas_root].backface_escape != 0u && nb_faces_along(st.normal, ray_dir, 0.0f);
 }
 

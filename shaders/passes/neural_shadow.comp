@@ -1,6 +1,6 @@
 // Neural visibility of shadow rays (hybrid renders), before passes/shadow.comp: the same ordered leaf
 // search and batched queries as path rays (passes/neural_traverse.comp), with any-hit semantics. The
-// state of shadow ray i lives at neural_state[capacity + i] while its leaves are queried; the decision
+// state of shadow ray i lives at neural state slot capacity + i while its leaves are queried; the decision
 // "occluded" goes to the ray's own NB_SHADOW_TMAX word (nb_shadow_mark_occluded), which shadow.comp
 // reads anyway: a ray found unoccluded stores nothing.
 //   op 0: every shadow ray: triangle any-hit (occluded -> done), else queue the first neural leaf;
@@ -27,7 +27,7 @@ void main() {
         NbPendingPair pl = nb_pending_load(slot);
         if (nb_pair_group(pl.group) == 0u) return; // the first pair of the ray's group resumes it
         i = pl.ray - cap;
-        st = neural_state[cap + i];
+        st = nb_state_load(cap + i);
         if (!nb_nl_is_pending(st.status)) return;
         bool last = st.status == NB_NRAY_PENDING_LAST;
         nb_nl_reduce_group(slot, nb_pair_group(pl.group), st);
@@ -36,7 +36,7 @@ void main() {
         if (last || st.best_t < NB_INF ||
             !nb_nl_may_have_more(st, uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, pl.ray - cap)))) {
             st.status = NB_NRAY_DONE;
-            neural_state[cap + i] = st;
+            nb_state_store(cap + i, st);
             if (st.best_t < NB_INF) nb_shadow_mark_occluded(i);
             return;
         }
@@ -72,5 +72,5 @@ void main() {
         if (op == 0u) return;
         st.status = NB_NRAY_DONE;
     }
-    neural_state[cap + i] = st;
+    nb_state_store(cap + i, st);
 }

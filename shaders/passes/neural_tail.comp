@@ -36,7 +36,7 @@ void main() {
     g_alpha_seed = shadow ? nb_shadow_alpha_seed(shadow_load1(NB_SHADOW_PIXEL, i) & ~NB_RAY_BACKFACE_BIT)
                           : ray_load1(pc.in_queue, NB_RAY_RNG, i);
     uint lod = (shadow || pc.depth != 0u) ? neural_params.lod_secondary : neural_params.lod_primary;
-    GpuNeuralRayState st = neural_state[ray];
+    GpuNeuralRayState st = nb_state_load(ray);
     bool last = st.status == NB_NRAY_PENDING_LAST; // no leaf left behind this group
     // The group queued by the last batched round, in key order.
     uint group = nb_pair_group(r.pl.group);
@@ -49,7 +49,7 @@ void main() {
     for (uint guard = 0u; guard <= neural_params.max_rounds; ++guard) {
         if (shadow && st.best_t < NB_INF) { // occluded
             st.status = NB_NRAY_DONE;
-            neural_state[ray] = st;
+            nb_state_store(ray, st);
             nb_shadow_mark_occluded(i);
             return;
         }
@@ -68,7 +68,7 @@ void main() {
         if (!found) {
             if (shadow) st.status = NB_NRAY_DONE;
             else nb_nl_finish_path(i, st);
-            neural_state[ray] = st;
+            nb_state_store(ray, st);
             return;
         }
         st.key_t = g_nl_cand_t[0];
@@ -96,5 +96,5 @@ void main() {
     } else {
         nb_nl_finish_path(i, st);
     }
-    neural_state[ray] = st;
+    nb_state_store(ray, st);
 }

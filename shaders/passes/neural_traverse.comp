@@ -30,13 +30,13 @@ void main() {
         NbPendingPair pl = nb_pending_load(slot);
         if (nb_pair_group(pl.group) == 0u) return; // the first pair of the ray's group resumes it
         i = pl.ray;
-        st = neural_state[i];
+        st = nb_state_load(i);
         if (!nb_nl_is_pending(st.status)) return;
         bool last = st.status == NB_NRAY_PENDING_LAST;
         nb_nl_reduce_group(slot, nb_pair_group(pl.group), st);
         if (last || !nb_nl_may_have_more(st, min(st.tri_t, st.best_t))) { // nothing left in front: no re-traversal
             nb_nl_finish_path(i, st);
-            neural_state[i] = st;
+            nb_state_store(i, st);
             return;
         }
     } else {
@@ -72,5 +72,5 @@ void main() {
         if (op == 0u) return;
         nb_nl_finish_path(i, st);
     }
-    neural_state[i] = st;
+    nb_state_store(i, st);
 }

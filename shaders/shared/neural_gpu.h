@@ -127,6 +127,8 @@ struct GpuNeuralRayState {
     uint rounds;    // leaves queried so far
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralRayState) == 64, "GpuNeuralRayState layout");
+// The passes move a state as 4 16-byte words in field order (lib/neural_bindings.glsl nb_state_load,
+// nb_state_store); the host reads the buffer as this struct (wavefront.cpp trace).
 
 // One neural asset of the model (engine/neural/model_file.h ModelAsset), indexed by a neural
 // GpuInstance's blas_root: where its N-BVH subtree starts in each LoD's GPU node array, and the scene
