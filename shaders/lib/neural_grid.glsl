@@ -3,9 +3,9 @@
 // the fp16 rounding point R1 of shared/mlp.h: fp16 grid values, fp32 corner weights, fp32 sum over
 // corners 0..7, one rounding to fp16 per level and feature.
 //
-// The including shader declares (scalar layout, any binding):
-//   GpuHashLevel neural_levels[];  // NB_GRID_MAX_LEVELS entries
-//   uvec2 neural_grid[];           // one entry = 4 fp16 features packed in 2 words (neural_gpu.h)
+// The including shader declares (any binding):
+//   uvec4 neural_levels[];         // std430: NB_GRID_MAX_LEVELS GpuHashLevel records, 2 words each
+//   uvec2 neural_grid[];           // scalar: one entry = 4 fp16 features packed in 2 words (neural_gpu.h)
 #ifndef NB_NEURAL_GRID_GLSL
 #define NB_NEURAL_GRID_GLSL
 #include "shared/hashgrid.h"
@@ -13,13 +13,29 @@
 #include "shared/neural_gpu.h"
 
 
+// Level l's parameters in two 16-byte loads (a scalar-layout GpuHashLevel took five 4-byte loads per
+// level and point; the subgroup's lanes all read the same level).
+GpuHashLevel nb_neural_level(uint l) {
+    uvec4 a = neural_levels[2u * l], b = neural_levels[2u * l + 1u];
+    GpuHashLevel lv;
+    lv.offset = a.x;
+    lv.size = a.y;
+    lv.resolution = a.z;
+    lv.scale = uintBitsToFloat(a.w);
+    lv.hashed = b.x;
+    lv.pad0 = b.y;
+    lv.pad1 = b.z;
+    lv.pad2 = b.w;
+    return lv;
+}
+
 // Round to the nearest fp16 value (round to nearest even on every conformant implementation: the
 // conversion of packHalf2x16 is correctly rounded in Vulkan). Saturates to +-inf like fp16.
 float nb_round_half(float x) { return unpackHalf2x16(packHalf2x16(vec2(x, 0.0f))).x; }
 
 // The 4 features of level l of one encoded point, each already rounded to fp16.
 vec4 nb_neural_level_features(vec3 p, uint l) {
-    GpuHashLevel lv = neural_levels[l];
+    GpuHashLevel lv = nb_neural_level(l);
     uvec3 cell;
     vec3 frac;
     nb_grid_position(lv, p, cell, frac);
@@ -70,7 +86,7 @@ void nb_neural_levels_paired(vec3 p_even, vec3 p_odd, uint l0, uint xbit, out ve
         vec3 fa[NB_GATHER_LEVELS];
         vec3 fb[NB_GATHER_LEVELS];
         [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g) {
-            GpuHashLevel lv = neural_levels[l0 + g];
+            GpuHashLevel lv = nb_neural_level(l0 + g);
             uvec3 ca, cb;
             nb_grid_position(lv, p_even, ca, fa[g]);
             nb_grid_position(lv, p_odd, cb, fb[g]);
