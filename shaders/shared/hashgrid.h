@@ -73,7 +73,10 @@ NB_FN uint nb_grid_vertex_index(GpuHashLevel level, uint x, uint y, uint z) {
     } else {
         idx = x + y * level.resolution + z * (level.resolution * level.resolution);
     }
-    return idx % level.size;
+    // The same value as idx % size, without the integer division where size is a power of two (every
+    // hashed level: size = 2^T; the test is uniform across a subgroup, which reads one level at a time).
+    uint size = level.size;
+    return (size & (size - 1u)) == 0u ? (idx & (size - 1u)) : (idx % size);
 }
 
 // Continuous position of an encoded coordinate at a level (one axis): integer cell and fraction.

@@ -130,6 +130,40 @@ TEST(HashGrid, DenseIndexAndTcnnAliasing) {
     EXPECT_EQ(nb_grid_vertex_index(lv[3], 63, 63, 64), 63u + 63u * 64u);
 }
 
+// The index takes `& (size - 1)` for power-of-two sizes instead of `% size`: the same value for every
+// vertex, on every level of tables with dense and hashed, power-of-two and other sizes (hashgrid.h).
+TEST(HashGrid, PowerOfTwoShortcutEqualsTheModulo) {
+    uint32_t state = 12345u;
+    auto next = [&] {
+        state = state * 1664525u + 1013904223u;
+        return state;
+    };
+    int pow2 = 0, other = 0;
+    for (uint32_t log2_hash : {4u, 13u, 17u, 18u, 22u}) {
+        for (uint32_t base : {2u, 7u, 16u, 100u}) {
+            NeuralConfig cfg;
+            cfg.log2_hash_size = log2_hash;
+            cfg.base_resolution = base;
+            for (const GpuHashLevel& lv : make_level_table(cfg)) {
+                ((lv.size & (lv.size - 1u)) == 0u ? pow2 : other)++;
+                const uint32_t r = lv.resolution;
+                const uint32_t edge[] = {0u, 1u, r - 1u, r, r + 1u, 0x7FFFFFFFu, 0xFFFFFFFEu, 0xFFFFFFFFu};
+                for (int k = 0; k < 300; ++k) {
+                    const uint32_t x = k < 64 ? edge[k % 8] : next(),
+                                   y = k < 64 ? edge[(k / 8) % 8] : next() % (r + 2u), z = next();
+                    const uint32_t idx = lv.hashed
+                                             ? nb_hash_coherent_prime(x, y, z)
+                                             : x + y * lv.resolution + z * (lv.resolution * lv.resolution);
+                    ASSERT_EQ(nb_grid_vertex_index(lv, x, y, z), idx % lv.size)
+                        << "size " << lv.size << " at " << x << ", " << y << ", " << z;
+                }
+            }
+        }
+    }
+    EXPECT_GT(pow2, 0);
+    EXPECT_GT(other, 0); // both branches taken
+}
+
 TEST(HashGrid, PositionWeightsAndSlots) {
     const auto lv = make_level_table(NeuralConfig{});
     uvec3 cell;
