@@ -77,7 +77,8 @@ void validate_level_table(const std::vector<GpuHashLevel>& levels) {
         const std::string at = "level table: level " + std::to_string(l) + ": ";
         if (lv.offset != expect_offset) throw Error(at + "offset " + std::to_string(lv.offset) + " is not contiguous");
         if (lv.size == 0u || lv.size > (1u << NB_GRID_MAX_LOG2_HASH)) throw Error(at + "invalid size " + std::to_string(lv.size));
-        if (lv.resolution < 2u) throw Error(at + "invalid resolution " + std::to_string(lv.resolution));
+        if (lv.resolution < 2u || lv.resolution >= NB_LEVEL_HASHED_BIT) // the GPU packs the flag in bit 31
+            throw Error(at + "invalid resolution " + std::to_string(lv.resolution));
         if (!std::isfinite(lv.scale) || lv.scale <= 0.0f || lv.scale > float(lv.resolution))
             throw Error(at + "invalid scale " + std::to_string(lv.scale));
         if (lv.hashed > 1u || lv.pad0 != 0u || lv.pad1 != 0u || lv.pad2 != 0u) throw Error(at + "invalid flags or padding");

@@ -26,7 +26,7 @@ uint64_t NeuralGpuBytes::total_for_lod(uint32_t lod) const {
 NeuralGpuBytes neural_gpu_bytes(const NeuralModel& model) {
     NeuralGpuBytes b;
     auto packed = [](size_t halves) { return uint64_t((halves + 1) / 2) * sizeof(uint32_t); }; // pack_halves
-    b.levels = uint64_t(model.levels.size()) * sizeof(GpuHashLevel);
+    b.levels = uint64_t(model.levels.size()) * sizeof(uvec4); // packed (hashgrid.h nb_level_pack)
     b.grid = packed(model.grid.size());
     b.mlp = packed(model.mlp.size());
     b.mlp_transposed = b.mlp;

@@ -132,7 +132,9 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
     if (model.levels.size() != NB_GRID_MAX_LEVELS || model.mlp.size() != NB_MLP_WEIGHT_COUNT || model.grid.empty() ||
         model.nodes.empty())
         throw Error("the model has no network or no N-BVH");
-    levels_ = vk::make_buffer(ctx, model.levels, "neural levels");
+    std::vector<uvec4> packed_levels;
+    for (const GpuHashLevel& l : model.levels) packed_levels.push_back(nb_level_pack(l)); // neural_grid.glsl
+    levels_ = vk::make_buffer(ctx, packed_levels, "neural levels");
     grid_ = vk::make_buffer(ctx, pack_halves(model.grid), "neural grid");
     mlp_ = vk::make_buffer(ctx, pack_halves(model.mlp), "neural mlp");
     mlp_t_ = vk::make_buffer(ctx, pack_halves(transpose_mlp(model.mlp)), "neural mlp transposed");

@@ -4,7 +4,7 @@
 // corners 0..7, one rounding to fp16 per level and feature.
 //
 // The including shader declares (any binding):
-//   uvec4 neural_levels[];         // std430: NB_GRID_MAX_LEVELS GpuHashLevel records, 2 words each
+//   uvec4 neural_levels[];         // std430: NB_GRID_MAX_LEVELS levels, packed by nb_level_pack
 //   uvec2 neural_grid[];           // scalar: one entry = 4 fp16 features packed in 2 words (neural_gpu.h)
 #ifndef NB_NEURAL_GRID_GLSL
 #define NB_NEURAL_GRID_GLSL
@@ -13,21 +13,9 @@
 #include "shared/neural_gpu.h"
 
 
-// Level l's parameters in two 16-byte loads (a scalar-layout GpuHashLevel took five 4-byte loads per
-// level and point; the subgroup's lanes all read the same level).
-GpuHashLevel nb_neural_level(uint l) {
-    uvec4 a = neural_levels[2u * l], b = neural_levels[2u * l + 1u];
-    GpuHashLevel lv;
-    lv.offset = a.x;
-    lv.size = a.y;
-    lv.resolution = a.z;
-    lv.scale = uintBitsToFloat(a.w);
-    lv.hashed = b.x;
-    lv.pad0 = b.y;
-    lv.pad1 = b.z;
-    lv.pad2 = b.w;
-    return lv;
-}
+// Level l's parameters in one 16-byte load (shared/hashgrid.h nb_level_pack; a scalar-layout
+// GpuHashLevel took five 4-byte loads per level and point; the subgroup's lanes all read the same level).
+GpuHashLevel nb_neural_level(uint l) { return nb_level_unpack(neural_levels[l]); }
 
 // Round to the nearest fp16 value (round to nearest even on every conformant implementation: the
 // conversion of packHalf2x16 is correctly rounded in Vulkan). Saturates to +-inf like fp16.

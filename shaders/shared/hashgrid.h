@@ -48,6 +48,30 @@ struct GpuHashLevel {
 };
 NB_STATIC_ASSERT(sizeof(GpuHashLevel) == 32, "GpuHashLevel must be 32 bytes");
 
+// The render passes read a level as one 16-byte word (lib/neural_grid.glsl nb_neural_level; the model
+// upload packs it): offset, size, resolution with the hashed flag in bit 31 (make_level_table keeps
+// resolutions below 2^31), scale. Not used by CUDA (the trainer reads GpuHashLevel).
+#define NB_LEVEL_HASHED_BIT 0x80000000u
+#if !defined(NB_CUDA)
+NB_FN uvec4 nb_level_pack(GpuHashLevel l) {
+    return uvec4(l.offset, l.size,
+                 (l.resolution & ~NB_LEVEL_HASHED_BIT) | (l.hashed != 0u ? NB_LEVEL_HASHED_BIT : 0u),
+                 floatBitsToUint(l.scale));
+}
+NB_FN GpuHashLevel nb_level_unpack(uvec4 w) {
+    GpuHashLevel l;
+    l.offset = w.x;
+    l.size = w.y;
+    l.resolution = w.z & ~NB_LEVEL_HASHED_BIT;
+    l.scale = uintBitsToFloat(w.w);
+    l.hashed = (w.z & NB_LEVEL_HASHED_BIT) != 0u ? 1u : 0u;
+    l.pad0 = 0u;
+    l.pad1 = 0u;
+    l.pad2 = 0u;
+    return l;
+}
+#endif
+
 // fma as tcnn's pos_fract uses it (fmaf). GLSL's fma is only guaranteed fused under `precise`;
 // without it the result may differ by one float rounding, which moves a cell only when
 // x*scale + 0.5 lands within 1 ulp of an integer.
@@ -73,10 +97,16 @@ NB_FN uint nb_grid_vertex_index(GpuHashLevel level, uint x, uint y, uint z) {
     } else {
         idx = x + y * level.resolution + z * (level.resolution * level.resolution);
     }
+#if defined(NB_GLSL)
+    return idx % level.size;
+#else
     // The same value as idx % size, without the integer division where size is a power of two (every
-    // hashed level: size = 2^T; the test is uniform across a subgroup, which reads one level at a time).
+    // hashed level: size = 2^T). CUDA trainer, H200: grid backward 0.648 -> 0.607 ms, encode 0.182 ->
+    // 0.196, step -2 %. The GLSL query kernels keep the modulo: the same branch there made the hybrid
+    // frames 3-6 % slower (results/perf/dropped/README.md).
     uint size = level.size;
     return (size & (size - 1u)) == 0u ? (idx & (size - 1u)) : (idx % size);
+#endif
 }
 
 // Continuous position of an encoded coordinate at a level (one axis): integer cell and fraction.

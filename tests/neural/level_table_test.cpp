@@ -204,3 +204,33 @@ TEST(Mlp, WeightIndexLayout) {
     EXPECT_EQ(nb_sigmoid(-200.0f), 0.0f);
     EXPECT_EQ(nb_sigmoid(200.0f), 1.0f);
 }
+
+// The render passes read each level packed in one 16-byte word (hashgrid.h nb_level_pack): every field
+// they use survives, for dense and hashed levels of several tables; resolutions at bit 31 are refused.
+TEST(HashGrid, PackedLevelsRoundTrip) {
+    for (uint32_t log2_hash : {4u, 14u, 18u, 24u}) {
+        for (uint32_t base : {2u, 16u, 4096u}) {
+            NeuralConfig cfg;
+            cfg.log2_hash_size = log2_hash;
+            cfg.base_resolution = base;
+            cfg.per_level_scale = base == 4096u ? 16.0f : 2.0f;
+            std::vector<GpuHashLevel> levels;
+            try {
+                levels = make_level_table(cfg);
+            } catch (const Error&) {
+                continue; // a table too large for the renderer
+            }
+            for (const GpuHashLevel& lv : levels) {
+                const GpuHashLevel u = nb_level_unpack(nb_level_pack(lv));
+                EXPECT_EQ(u.offset, lv.offset);
+                EXPECT_EQ(u.size, lv.size);
+                EXPECT_EQ(u.resolution, lv.resolution);
+                EXPECT_EQ(floatBitsToUint(u.scale), floatBitsToUint(lv.scale));
+                EXPECT_EQ(u.hashed, lv.hashed);
+            }
+        }
+    }
+    std::vector<GpuHashLevel> bad = make_level_table(NeuralConfig{});
+    bad[7].resolution = NB_LEVEL_HASHED_BIT;
+    EXPECT_THROW(validate_level_table(bad), Error);
+}
