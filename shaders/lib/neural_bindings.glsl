@@ -8,7 +8,7 @@
 #include "shared/neural_gpu.h"
 
 layout(set = 0, binding = NB_BIND_NEURAL_LEVELS, std430) readonly buffer NeuralLevelBuffer { uvec4 neural_levels[]; }; // GpuHashLevel (lib/neural_grid.glsl)
-layout(set = 0, binding = NB_BIND_NEURAL_GRID, std430) readonly buffer NeuralGridBuffer { uvec2 neural_grid[]; };
+layout(set = 0, binding = NB_BIND_NEURAL_GRID, scalar) readonly buffer NeuralGridBuffer { uvec2 neural_grid[]; };
 #ifdef NB_NEURAL_MLP_AS_HALF
 #extension GL_EXT_shader_16bit_storage : require
 #extension GL_EXT_shader_explicit_arithmetic_types_float16 : require

@@ -10,7 +10,7 @@
 
 layout(push_constant, scalar) uniform EvalPushBlock { GpuNeuralEvalPush pc; };
 layout(set = 0, binding = NB_NEVAL_BIND_LEVELS, std430) readonly buffer LevelBuffer { uvec4 neural_levels[]; }; // GpuHashLevel
-layout(set = 0, binding = NB_NEVAL_BIND_GRID, std430) readonly buffer GridBuffer { uvec2 neural_grid[]; };
+layout(set = 0, binding = NB_NEVAL_BIND_GRID, scalar) readonly buffer GridBuffer { uvec2 neural_grid[]; };
 layout(set = 0, binding = NB_NEVAL_BIND_QUERIES, scalar) readonly buffer QueryBuffer { GpuNeuralQuery queries[]; };
 layout(set = 0, binding = NB_NEVAL_BIND_HITS, scalar) writeonly buffer HitBuffer { GpuNeuralHit hits[]; };
 

@@ -5,8 +5,7 @@
 //
 // The including shader declares (any binding):
 //   uvec4 neural_levels[];         // std430: NB_GRID_MAX_LEVELS levels, packed by nb_level_pack
-//   uvec2 neural_grid[];           // std430 (8-byte aligned entries, one 8-byte load each): 4 fp16
-//                                  // features packed in 2 words (neural_gpu.h)
+//   uvec2 neural_grid[];           // scalar: one entry = 4 fp16 features packed in 2 words (neural_gpu.h)
 #ifndef NB_NEURAL_GRID_GLSL
 #define NB_NEURAL_GRID_GLSL
 #include "shared/hashgrid.h"
