@@ -16,16 +16,6 @@ namespace {
 
 constexpr uint32_t kEntries = 1u << 21, kItems = (1u << 18) * 3u * 6u, kCorners = 8u;
 
-__device__ uint32_t entry_of(uint32_t item, uint32_t corner, uint32_t seed) {
-    uint32_t x = item * kCorners + corner + seed; // a 32-bit mix (lowbias32)
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x & (kEntries - 1u);
-}
-
 enum class Way { f32x4, f16x2_v2, half2_x2, f32x2_x2 };
 
 // Vector reductions need sm_90; other architectures compile an empty kernel (main refuses them).
@@ -35,7 +25,13 @@ template <Way W> __global__ void k_scatter(float* grad, uint32_t seed) {
     if (i >= kItems) return;
     const float w = 1e-3f * float(i & 7u);
     for (uint32_t c = 0; c < kCorners; ++c) {
-        const uint32_t e = entry_of(i, c, seed);
+        uint32_t e = i * kCorners + c + seed; // the corner's entry: a 32-bit mix (lowbias32)
+        e ^= e >> 16;
+        e *= 0x7feb352du;
+        e ^= e >> 15;
+        e *= 0x846ca68bu;
+        e ^= e >> 16;
+        e &= kEntries - 1u;
         if constexpr (W == Way::f32x4) {
             atomicAdd(reinterpret_cast<float4*>(grad) + e, make_float4(w, w, w, w));
         } else if constexpr (W == Way::f32x2_x2) {
