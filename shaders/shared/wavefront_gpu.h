@@ -143,6 +143,8 @@ NB_STATIC_ASSERT(sizeof(GpuQueueCounters) == 68 + 8 * NB_STAT_DEPTHS, "GpuQueueC
 // result goes to its own slot.
 #define NB_RS_BINS 32768u       // 2^(6 direction bits + 9 origin bits)
 #define NB_RS_SCAN_THREADS 128u // queue_args.comp's workgroup: Vulkan's guaranteed minimum size
+// queue_args.comp scans and zeroes each invocation's NB_RS_BINS / NB_RS_SCAN_THREADS bins as uvec4s.
+NB_STATIC_ASSERT(NB_RS_BINS % (4u * NB_RS_SCAN_THREADS) == 0u, "ray-sort bins per scan invocation: a multiple of 4");
 // Sort binding layout (words): path-queue bins for queue 0 and 1, shadow bins, the scene's world bounds
 // (lo.xyz, hi.xyz as floats, written by the host), then the order of the path queue being traced
 // (capacity) and of the shadow queue (capacity).
