@@ -1,7 +1,8 @@
 // Set-0 bindings of the neural part of the wavefront renderer (shared/neural_gpu.h NB_BIND_NEURAL_*),
 // included after lib/bindings.glsl by every pass that touches neural data. The weight buffer is seen as
-// packed fp16 pairs (uint) unless the pass defines NB_NEURAL_MLP_AS_HALF before including this (the
-// cooperative-matrix query pass, which reads the transposed copy, NB_BIND_NEURAL_MLP_T, as float16_t).
+// packed fp16 pairs (uint) unless the pass defines NB_NEURAL_MLP_AS_TILES before including this (the
+// cooperative-matrix query pass, which reads the transposed, tiled copy, NB_BIND_NEURAL_MLP_T, in
+// 16-byte words: lib/neural_mlp_coopmat.glsl).
 #ifndef NB_NEURAL_BINDINGS_GLSL
 #define NB_NEURAL_BINDINGS_GLSL
 #include "shared/hashgrid.h"
@@ -9,10 +10,8 @@
 
 layout(set = 0, binding = NB_BIND_NEURAL_LEVELS, std430) readonly buffer NeuralLevelBuffer { uvec4 neural_levels[]; }; // GpuHashLevel (lib/neural_grid.glsl)
 layout(set = 0, binding = NB_BIND_NEURAL_GRID, scalar) readonly buffer NeuralGridBuffer { uvec2 neural_grid[]; };
-#ifdef NB_NEURAL_MLP_AS_HALF
-#extension GL_EXT_shader_16bit_storage : require
-#extension GL_EXT_shader_explicit_arithmetic_types_float16 : require
-layout(set = 0, binding = NB_BIND_NEURAL_MLP_T, scalar) readonly buffer NeuralMlpBuffer { float16_t neural_mlp_h[]; };
+#ifdef NB_NEURAL_MLP_AS_TILES
+layout(set = 0, binding = NB_BIND_NEURAL_MLP_T, std430) readonly buffer NeuralMlpBuffer { uvec4 neural_mlp_tiles[]; };
 #else
 layout(set = 0, binding = NB_BIND_NEURAL_MLP, scalar) readonly buffer NeuralMlpBuffer { uint neural_mlp[]; };
 #endif

@@ -1,8 +1,7 @@
 // Body of passes/neural_eval_coop{16,32}.comp (the includer defines NB_COOP_ACC_BITS): 64 queries per
 // workgroup through the fused cooperative-matrix MLP.
 #include "lib/neural_eval_common.glsl"
-#extension GL_EXT_shader_16bit_storage : require
-layout(set = 0, binding = NB_NEVAL_BIND_MLP, scalar) readonly buffer MlpBuffer { float16_t neural_mlp_h[]; };
+layout(set = 0, binding = NB_NEVAL_BIND_MLP, std430) readonly buffer MlpBuffer { uvec4 neural_mlp_tiles[]; };
 #include "lib/neural_grid.glsl"
 #include "lib/neural_mlp_coopmat.glsl"
 

@@ -12,7 +12,8 @@
 //
 // Only compiled into passes that are created on devices with VK_NV_cooperative_matrix, 16x16x16 fp16
 // shapes and subgroup size 32 (engine/render/neural_model_gpu.cpp checks). The including shader
-// declares `float16_t neural_mlp_h[];` (the TRANSPOSED weight buffer seen as halves), defines NB_COOP_ACC_BITS,
+// declares `uvec4 neural_mlp_tiles[];` (the TRANSPOSED, tiled weight buffer in 16-byte words, 8 halves
+// each: a tile is 32 words, one tile row 2), defines NB_COOP_ACC_BITS,
 // fills nb_sh_x (query row r, features in mlp.h input order: nb_coop_x_write4) and calls
 // nb_mlp_forward_coopmat() from uniform control flow; the 8 outputs (fp32, before the sigmoid) are then in
 // nb_sh_y[r*NB_COOP_Y_STRIDE + 0..7].
@@ -91,7 +92,7 @@ float nb_coop_x_read(uint row, uint f) {
             coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 4u, NB_COOP_STRIDE_V, false); \
             NB_UNROLL for (uint nt = 0u; nt < 4u; ++nt) {                                             \
                 NB_FCM(16) b;                                                                         \
-                coopMatLoadNV(b, WBUF, (WOFF) + nb_coop_weight_slot(WOUTS, kt * 16u, nt * 16u), 16u, false); \
+                coopMatLoadNV(b, WBUF, ((WOFF) + nb_coop_weight_slot(WOUTS, kt * 16u, nt * 16u)) / 8u, 2u, false); \
                 acc[nt] = coopMatMulAddNV(a0, b, acc[nt]);                                            \
                 acc[4u + nt] = coopMatMulAddNV(a1, b, acc[4u + nt]);                                  \
             }                                                                                         \
@@ -108,19 +109,19 @@ float nb_coop_x_read(uint row, uint f) {
 
 void nb_mlp_forward_coopmat() {
     uint row0 = (gl_LocalInvocationID.x / NB_COOP_ROWS) * NB_COOP_ROWS;
-    NB_COOP_HIDDEN_LAYER(NB_MLP_INPUTS, neural_mlp_h, nb_mlp_layer_offset(0u), NB_MLP_WIDTH)
-    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_h, nb_mlp_layer_offset(1u), NB_MLP_WIDTH)
-    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_h, nb_mlp_layer_offset(2u), NB_MLP_WIDTH)
-    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_h, nb_mlp_layer_offset(3u), NB_MLP_WIDTH)
+    NB_COOP_HIDDEN_LAYER(NB_MLP_INPUTS, neural_mlp_tiles, nb_mlp_layer_offset(0u), NB_MLP_WIDTH)
+    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_tiles, nb_mlp_layer_offset(1u), NB_MLP_WIDTH)
+    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_tiles, nb_mlp_layer_offset(2u), NB_MLP_WIDTH)
+    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_tiles, nb_mlp_layer_offset(3u), NB_MLP_WIDTH)
     // Output layer (16 x 64, rows 8..15 zero padding): fp32 pre-activation (R4).
     {
         NB_FCM(NB_COOP_ACC_BITS) acc0 = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));
         NB_FCM(NB_COOP_ACC_BITS) acc1 = acc0;
         NB_UNROLL for (uint kt = 0u; kt < NB_MLP_WIDTH / 16u; ++kt) {
             NB_FCM(16) b;
-            coopMatLoadNV(b, neural_mlp_h,
-                          nb_mlp_layer_offset(NB_MLP_HIDDEN_LAYERS) + nb_coop_weight_slot(NB_MLP_OUTPUTS_PADDED, kt * 16u, 0u),
-                          16u, false);
+            coopMatLoadNV(b, neural_mlp_tiles,
+                          (nb_mlp_layer_offset(NB_MLP_HIDDEN_LAYERS) + nb_coop_weight_slot(NB_MLP_OUTPUTS_PADDED, kt * 16u, 0u)) / 8u,
+                          2u, false);
             NB_FCM(16) a0;
             NB_FCM(16) a1;
             coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 4u, NB_COOP_STRIDE_V, false);

@@ -1,7 +1,7 @@
 // Body of passes/neural_query_coop{16,32}.comp: the neural query pass through the fused
 // cooperative-matrix MLP (64 pairs per workgroup; the includer defines NB_COOP_ACC_BITS).
 #include "lib/bindings.glsl"
-#define NB_NEURAL_MLP_AS_HALF 1
+#define NB_NEURAL_MLP_AS_TILES 1
 #include "lib/neural_bindings.glsl"
 #include "lib/neural_grid.glsl"
 #include "lib/neural_mlp_coopmat.glsl"
