@@ -37,10 +37,11 @@
 // 16 bytes (cooperative-matrix loads) that spreads the per-invocation feature stores over 8 banks
 // instead of 2.
 #define NB_COOP_STRIDE 104u
-// The activation buffer is an array of uvec2 (4 halves): the staging writes a level's 4 features with
-// one 64-bit store (16-bit stores at this stride conflict 4-way on the banks); cooperative-matrix
-// loads and stores address it in units of uvec2 (offsets and strides / 4).
-#define NB_COOP_STRIDE_V (NB_COOP_STRIDE / 4u)
+// The activation buffer is an array of uvec4 (8 halves), so that the driver knows every row and tile
+// is 16-byte aligned; cooperative-matrix loads and stores address it in units of uvec4 (offsets and
+// strides / 8). The staging writes a level's 4 features as one 64-bit half of a word (16-bit stores at
+// this stride conflict 4-way on the banks).
+#define NB_COOP_STRIDE_V (NB_COOP_STRIDE / 8u)
 // Row stride of the fp32 output buffer: 20 floats instead of 16, so reading a row's 8 outputs
 // conflicts 4-way instead of 16-way (80 bytes, still a multiple of 16 for coopMatStoreNV).
 #define NB_COOP_Y_STRIDE 20u
@@ -65,16 +66,21 @@
 
 // Layer inputs and outputs, in place: each layer loads its whole input tile set into accumulators
 // before any output is stored (a barrier separates the two), so one buffer serves all layers.
-shared uvec2 nb_sh_x[NB_NEURAL_GROUP * NB_COOP_STRIDE_V];
+shared uvec4 nb_sh_x[NB_NEURAL_GROUP * NB_COOP_STRIDE_V];
 shared float nb_sh_y[NB_NEURAL_GROUP * NB_COOP_Y_STRIDE];
 
 // Features f0..f0+3 (f0 a multiple of 4) of row `row`, already rounded to fp16 (exact when packed).
 void nb_coop_x_write4(uint row, uint f0, vec4 v) {
-    nb_sh_x[row * NB_COOP_STRIDE_V + f0 / 4u] = uvec2(packHalf2x16(v.xy), packHalf2x16(v.zw));
+    uvec2 e = uvec2(packHalf2x16(v.xy), packHalf2x16(v.zw));
+    uint i = row * NB_COOP_STRIDE_V + f0 / 8u;
+    if ((f0 & 4u) == 0u)
+        nb_sh_x[i].xy = e;
+    else
+        nb_sh_x[i].zw = e;
 }
 float nb_coop_x_read(uint row, uint f) {
-    uvec2 e = nb_sh_x[row * NB_COOP_STRIDE_V + f / 4u];
-    vec2 h = unpackHalf2x16((f & 2u) != 0u ? e.y : e.x);
+    uint w = nb_sh_x[row * NB_COOP_STRIDE_V + f / 8u][(f / 2u) & 3u];
+    vec2 h = unpackHalf2x16(w);
     return (f & 1u) != 0u ? h.y : h.x;
 }
 
@@ -88,8 +94,8 @@ float nb_coop_x_read(uint row, uint f) {
         NB_UNROLL for (uint kt = 0u; kt < (K) / 16u; ++kt) {                                          \
             NB_FCM(16) a0;                                                                            \
             NB_FCM(16) a1;                                                                            \
-            coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 4u, NB_COOP_STRIDE_V, false);   \
-            coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 4u, NB_COOP_STRIDE_V, false); \
+            coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false);   \
+            coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false); \
             NB_UNROLL for (uint nt = 0u; nt < 4u; ++nt) {                                             \
                 NB_FCM(16) b;                                                                         \
                 coopMatLoadNV(b, WBUF, ((WOFF) + nb_coop_weight_slot(WOUTS, kt * 16u, nt * 16u)) / 8u, 2u, false); \
@@ -102,7 +108,7 @@ float nb_coop_x_read(uint row, uint f) {
             NB_UNROLL for (int e = 0; e < acc[j].length(); ++e) acc[j][e] = max(acc[j][e], NB_ACC_T(0.0));      \
             NB_FCM(16) o = NB_FCM(16)(acc[j]);                                                        \
             uint r = row0 + (j >> 2u) * 16u;                                                          \
-            coopMatStoreNV(o, nb_sh_x, r * NB_COOP_STRIDE_V + (j & 3u) * 4u, NB_COOP_STRIDE_V, false); \
+            coopMatStoreNV(o, nb_sh_x, r * NB_COOP_STRIDE_V + (j & 3u) * 2u, NB_COOP_STRIDE_V, false); \
         }                                                                                             \
         NB_COOP_SYNC();                                                                               \
     }
@@ -124,8 +130,8 @@ void nb_mlp_forward_coopmat() {
                           2u, false);
             NB_FCM(16) a0;
             NB_FCM(16) a1;
-            coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 4u, NB_COOP_STRIDE_V, false);
-            coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 4u, NB_COOP_STRIDE_V, false);
+            coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false);
+            coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false);
             acc0 = coopMatMulAddNV(a0, b, acc0);
             acc1 = coopMatMulAddNV(a1, b, acc1);
         }
