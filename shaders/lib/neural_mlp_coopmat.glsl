@@ -148,20 +148,14 @@ void nb_mlp_forward_coopmat() {
 void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
 #if NB_COOP_FAST
     uint xbit = gl_SubgroupInvocationID & 1u;
-    // Level groups outside, points inside: the group's index choice (and, where the driver keeps them,
-    // its level words) once for the 3 points.
-    for (uint l0 = 0u; l0 < NB_GRID_MAX_LEVELS; l0 += NB_GATHER_LEVELS) {
-        bool masked = nb_neural_group_masked(l0);
-        for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
-            vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
-            vec3 partner = subgroupShuffleXor(p, 1u);
-            vec3 p_even = xbit == 0u ? p : partner;
-            vec3 p_odd = xbit == 0u ? partner : p;
+    for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
+        vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
+        vec3 partner = subgroupShuffleXor(p, 1u);
+        vec3 p_even = xbit == 0u ? p : partner;
+        vec3 p_odd = xbit == 0u ? partner : p;
+        for (uint l0 = 0u; l0 < NB_GRID_MAX_LEVELS; l0 += NB_GATHER_LEVELS) {
             vec4 f[NB_GATHER_LEVELS];
-            if (masked)
-                nb_neural_levels_paired_impl(p_even, p_odd, l0, xbit, true, f);
-            else
-                nb_neural_levels_paired_impl(p_even, p_odd, l0, xbit, false, f);
+            nb_neural_levels_paired(p_even, p_odd, l0, xbit, f);
             [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g)
                 nb_coop_x_write4(local, nb_feature_slot(k, l0 + g, 0u), valid ? f[g] : vec4(0.0f));
         }
