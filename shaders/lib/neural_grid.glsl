@@ -64,12 +64,7 @@ vec4 nb_neural_level_features(vec3 p, uint l) {
 // sum(even corners) + sum(odd corners), rounded once to fp16 (R1). That order differs from the
 // reference's 0..7 chain, so a feature can differ by one fp16 ulp from the CPU reference (the coopmat
 // MLP sums in another order too; tests/neuralvk bounds both). All 32 lanes must be active (shuffles).
-// One level group of the paired gather. `masked` (a constant at every call, so each call site is its own
-// specialised copy): every level of the group is hashed with a power-of-two size, so each corner's index
-// is `hash & (size - 1)` instead of `% size` (the same value, shared/hashgrid.h). Selecting per corner
-// (5cae070) made the frames 3-6 % slower; here the choice is one uniform branch per level group.
-void nb_neural_levels_paired_impl(vec3 p_even, vec3 p_odd, uint l0, uint xbit, const bool masked,
-                                  out vec4 f[NB_GATHER_LEVELS]) {
+void nb_neural_levels_paired(vec3 p_even, vec3 p_odd, uint l0, uint xbit, out vec4 f[NB_GATHER_LEVELS]) {
     // A loop of ONE iteration on purpose: the same code without it (straight-line) ran 0.43 instead of
     // 0.57 G queries/s in the v15 kernel (results/neural/README.md), presumably because the driver then
     // schedules the level loop around it differently (more registers, fewer resident warps).
@@ -84,9 +79,8 @@ void nb_neural_levels_paired_impl(vec3 p_even, vec3 p_odd, uint l0, uint xbit, c
             nb_grid_position(lv, p_even, ca, fa[g]);
             nb_grid_position(lv, p_odd, cb, fb[g]);
             [[unroll]] for (uint j = 0u; j < 4u; ++j) {
-                uint c = 2u * j + xbit;
-                ea[g * 4u + j] = neural_grid[masked ? nb_grid_corner_entry_pow2(lv, ca, c) : nb_grid_corner_entry(lv, ca, c)];
-                eb[g * 4u + j] = neural_grid[masked ? nb_grid_corner_entry_pow2(lv, cb, c) : nb_grid_corner_entry(lv, cb, c)];
+                ea[g * 4u + j] = neural_grid[nb_grid_corner_entry(lv, ca, 2u * j + xbit)];
+                eb[g * 4u + j] = neural_grid[nb_grid_corner_entry(lv, cb, 2u * j + xbit)];
             }
         }
         [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g) {
@@ -104,23 +98,6 @@ void nb_neural_levels_paired_impl(vec3 p_even, vec3 p_odd, uint l0, uint xbit, c
             f[g] = vec4(nb_round_half(sum.x), nb_round_half(sum.y), nb_round_half(sum.z), nb_round_half(sum.w));
         }
     }
-}
-
-// True when levels l0 .. l0 + NB_GATHER_LEVELS - 1 are all hashed with power-of-two sizes (uniform).
-bool nb_neural_group_masked(uint l0) {
-    bool all = true;
-    [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g) {
-        uvec4 w = neural_levels[l0 + g];
-        all = all && (w.z & NB_LEVEL_HASHED_BIT) != 0u && (w.y & (w.y - 1u)) == 0u;
-    }
-    return all;
-}
-
-void nb_neural_levels_paired(vec3 p_even, vec3 p_odd, uint l0, uint xbit, out vec4 f[NB_GATHER_LEVELS]) {
-    if (nb_neural_group_masked(l0))
-        nb_neural_levels_paired_impl(p_even, p_odd, l0, xbit, true, f);
-    else
-        nb_neural_levels_paired_impl(p_even, p_odd, l0, xbit, false, f);
 }
 #endif
 

@@ -140,14 +140,6 @@ NB_FN uint nb_grid_corner_entry(GpuHashLevel level, uvec3 cell, uint corner) {
     return level.offset + nb_grid_corner_index(level, cell, corner);
 }
 
-// nb_grid_corner_entry for a hashed level whose size is a power of two (callers check both): the hash
-// masked instead of reduced with `%`, the same value.
-NB_FN uint nb_grid_corner_entry_pow2(GpuHashLevel level, uvec3 cell, uint corner) {
-    return level.offset + (nb_hash_coherent_prime(cell.x + (corner & 1u), cell.y + ((corner >> 1u) & 1u),
-                                                  cell.z + ((corner >> 2u) & 1u)) &
-                           (level.size - 1u));
-}
-
 // Trilinear weight of corner c, multiplied in tcnn's order (x, then y, then z).
 NB_FN float nb_grid_corner_weight(vec3 frac, uint corner) {
     float w = 1.0f;
