@@ -4,8 +4,8 @@
 // tile), and the grid backward (scatter to the 8 corners of every level).
 //
 // MLP kernel layout (one block = 8 warps = 128 samples per tile, persistent over tiles):
-//   shared: W (fp16, 19456), X0 (128 x 96), H1..H4 (128 x 64; H_{m+1} is overwritten by dZ_m once
-//   dW_{m+1} has consumed it), dZ4 (128 x 16), per-warp fp32 staging (16 x 64).
+//   shared: W (fp16, 19456 in rows padded to 21632: w_ld), X0 (128 x 96), H1..H4 (128 x 64; H_{m+1} is
+//   overwritten by dZ_m once dW_{m+1} has consumed it), dZ4 (128 x 16), per-warp fp32 staging (16 x 64).
 //   Forward and the data path of the backward are warp-local (16 samples each); weight gradients
 //   dW_m = dZ_m^T X_m use K = 128 (the whole tile) and accumulate into the block's own fp32 slice in
 //   global memory (L2-resident); slices are summed in a fixed order afterwards, so MLP gradients are
@@ -25,7 +25,19 @@ constexpr int kLdH = NB_MLP_WIDTH + 8;    // 72
 constexpr int kLdO = 16 + 8;              // 24
 constexpr int kLdS = 16 + 4;              // 20 floats (per-warp 16 x 16 fp32 staging)
 
-constexpr size_t kSmemW = NB_MLP_WEIGHT_COUNT * 2;
+// The weights in shared memory, each matrix W_m row-major (outputs x inputs) with its rows padded by 8
+// halves: a row stride of 128 or 192 bytes put the 8 rows of every ldmatrix on the same banks (ncu on
+// the H200: 71 % of k_mlp's shared-memory wavefronts were bank-conflict replays).
+__host__ __device__ constexpr int w_ld(int m) { return int(m == 0 ? NB_MLP_INPUTS : NB_MLP_WIDTH) + 8; }
+__host__ __device__ constexpr int w_rows(int m) {
+    return m == int(NB_MLP_HIDDEN_LAYERS) ? int(NB_MLP_OUTPUTS_PADDED) : int(NB_MLP_WIDTH);
+}
+__host__ __device__ constexpr int w_offset(int m) {
+    return m == 0 ? 0 : w_offset(m - 1) + w_rows(m - 1) * w_ld(m - 1);
+}
+constexpr size_t kSmemW = size_t(w_offset(int(NB_MLP_HIDDEN_LAYERS) + 1)) * 2;
+static_assert(w_offset(1) % 16 == 0 && w_offset(2) % 16 == 0 && w_offset(4) % 16 == 0 && kSmemW % 128 == 0,
+              "wmma tiles need 32-byte aligned starts");
 constexpr size_t kSmemX0 = size_t(kTile) * kLdIn * 2;
 constexpr size_t kSmemH = size_t(kTile) * kLdH * 2;
 constexpr size_t kSmemO = size_t(kTile) * kLdO * 2;
@@ -207,7 +219,7 @@ static_assert(int(FragC::num_elements) == int(FragCh::num_elements), "accumulato
 // H(16 x 64) = fp16(relu(X(16 x 16*KT) W_m^T)) for one warp (rounding point R3 of mlp.h), stored as fp16.
 // The A fragments of the warp's rows are loaded once and reused for the 4 output column tiles.
 template <int KT>
-__device__ void layer_forward_relu(const __half* x, int ldx, const __half* w, __half* out) {
+__device__ void layer_forward_relu(const __half* x, int ldx, const __half* w, int ldw, __half* out) {
     FragA a[KT];
 #pragma unroll
     for (int kk = 0; kk < KT; ++kk) wmma::load_matrix_sync(a[kk], x + kk * 16, ldx);
@@ -218,7 +230,7 @@ __device__ void layer_forward_relu(const __half* x, int ldx, const __half* w, __
 #pragma unroll
         for (int kk = 0; kk < KT; ++kk) {
             FragBc bm;
-            wmma::load_matrix_sync(bm, w + size_t(j) * 16 * (16 * KT) + kk * 16, 16 * KT); // W^T as col-major
+            wmma::load_matrix_sync(bm, w + size_t(j) * 16 * ldw + kk * 16, ldw); // W^T as col-major
             wmma::mma_sync(acc, a[kk], bm, acc);
         }
         FragCh h;
@@ -228,9 +240,10 @@ __device__ void layer_forward_relu(const __half* x, int ldx, const __half* w, __
     }
 }
 
-// dX(16 x 16*NJ) = dZ(16 x 16*KT) W_m (16*KT x cols) for one warp, into registers. W_m row-major.
+// dX(16 x 16*NJ) = dZ(16 x 16*KT) W_m (16*KT x 16*NJ) for one warp, into registers. W_m row-major, row
+// stride ldw.
 template <int KT, int NJ>
-__device__ void layer_backward_data(const __half* dz, int lddz, const __half* w, int cols, FragC (&out)[NJ]) {
+__device__ void layer_backward_data(const __half* dz, int lddz, const __half* w, int ldw, FragC (&out)[NJ]) {
     FragA a[KT];
 #pragma unroll
     for (int kk = 0; kk < KT; ++kk) wmma::load_matrix_sync(a[kk], dz + kk * 16, lddz);
@@ -240,7 +253,7 @@ __device__ void layer_backward_data(const __half* dz, int lddz, const __half* w,
 #pragma unroll
         for (int kk = 0; kk < KT; ++kk) {
             FragBr bm;
-            wmma::load_matrix_sync(bm, w + size_t(kk) * 16 * cols + j * 16, cols);
+            wmma::load_matrix_sync(bm, w + size_t(kk) * 16 * ldw + j * 16, ldw);
             wmma::mma_sync(out[j], a[kk], bm, out[j]);
         }
     }
@@ -315,8 +328,14 @@ k_mlp(DevNetwork net, DevBatch b, LossParams lp, float* slices, uint32_t* flag) 
     }
     wmma::fill_fragment(g4[0], 0.0f);
 
-    for (int i = threadIdx.x; i < int(NB_MLP_WEIGHT_COUNT / 8); i += blockDim.x)
-        reinterpret_cast<uint4*>(sW)[i] = reinterpret_cast<const uint4*>(net.mlp_h)[i];
+    // The weights into their padded rows (w_ld), 8 halves at a time.
+    for (int m = 0; m <= int(NB_MLP_HIDDEN_LAYERS); ++m) {
+        const int row8 = int(nb_mlp_layer_inputs(uint32_t(m))) / 8;
+        const uint4* src = reinterpret_cast<const uint4*>(net.mlp_h + nb_mlp_layer_offset(uint32_t(m)));
+        uint4* dst = reinterpret_cast<uint4*>(sW + w_offset(m));
+        for (int i = threadIdx.x; i < w_rows(m) * row8; i += blockDim.x)
+            dst[(i / row8) * (w_ld(m) / 8) + i % row8] = src[i];
+    }
     __syncthreads();
 
     const int tiles = int((b.n + kTile - 1) / kTile);
@@ -332,10 +351,11 @@ k_mlp(DevNetwork net, DevBatch b, LossParams lp, float* slices, uint32_t* flag) 
         }
         __syncwarp();
         // Forward, hidden layers: H_{m+1} = fp16(relu(X_m W_m^T)) (rounding point R3 of mlp.h).
-        layer_forward_relu<6>(sX0 + row0 * kLdIn, kLdIn, sW + nb_mlp_layer_offset(0), sH[0] + row0 * kLdH);
+        layer_forward_relu<6>(sX0 + row0 * kLdIn, kLdIn, sW + w_offset(0), w_ld(0), sH[0] + row0 * kLdH);
         __syncwarp();
         for (int m = 1; m < 4; ++m) {
-            layer_forward_relu<4>(sH[m - 1] + row0 * kLdH, kLdH, sW + nb_mlp_layer_offset(m), sH[m] + row0 * kLdH);
+            layer_forward_relu<4>(sH[m - 1] + row0 * kLdH, kLdH, sW + w_offset(m), w_ld(m),
+                                  sH[m] + row0 * kLdH);
             __syncwarp();
         }
         // Output layer (16 rows, 8 used): fp32 pre-activation (R4), sigmoid, loss, dZ4.
@@ -346,7 +366,7 @@ k_mlp(DevNetwork net, DevBatch b, LossParams lp, float* slices, uint32_t* flag) 
                 FragA a;
                 FragBc bm;
                 wmma::load_matrix_sync(a, sH[3] + row0 * kLdH + kk * 16, kLdH);
-                wmma::load_matrix_sync(bm, sW + nb_mlp_layer_offset(4) + kk * 16, NB_MLP_WIDTH);
+                wmma::load_matrix_sync(bm, sW + w_offset(4) + kk * 16, w_ld(4));
                 wmma::mma_sync(acc, a, bm, acc);
             }
             wmma::store_matrix_sync(stage, acc, kLdS, wmma::mem_row_major);
@@ -387,7 +407,7 @@ k_mlp(DevNetwork net, DevBatch b, LossParams lp, float* slices, uint32_t* flag) 
         }
         // Backward. dX4 = dZ4 W4 (16 x 64), kept in registers.
         FragC dx[4];
-        layer_backward_data<1, 4>(sO + row0 * kLdO, kLdO, sW + nb_mlp_layer_offset(4), NB_MLP_WIDTH, dx);
+        layer_backward_data<1, 4>(sO + row0 * kLdO, kLdO, sW + w_offset(4), w_ld(4), dx);
         __syncthreads();
         if (warp < 4) weight_grad<1>(sO, kLdO, sH[3], kLdH, 0, warp, g4);
         for (int m = 3; m >= 0; --m) {
@@ -395,13 +415,13 @@ k_mlp(DevNetwork net, DevBatch b, LossParams lp, float* slices, uint32_t* flag) 
             __half* hz = sH[m] + row0 * kLdH;
             relu_mask_in_place(hz, dx);
             __syncwarp();
-            const __half* w = sW + nb_mlp_layer_offset(m);
+            const __half* w = sW + w_offset(m);
             if (m > 0) {
-                layer_backward_data<4, 4>(hz, kLdH, w, NB_MLP_WIDTH, dx);
+                layer_backward_data<4, 4>(hz, kLdH, w, w_ld(m), dx);
             } else {
                 // dL/dfeatures straight to global memory (fp32, loss-scaled), rows past the batch skipped.
                 FragC dxin[6];
-                layer_backward_data<4, 6>(hz, kLdH, w, NB_MLP_INPUTS, dxin);
+                layer_backward_data<4, 6>(hz, kLdH, w, w_ld(0), dxin);
                 float* out = b.dfeatures + size_t(s0) * NB_MLP_INPUTS;
                 if (s0 + 16 <= b.n) {
 #pragma unroll
