@@ -90,8 +90,11 @@ constexpr uint32_t kCoarseSmemBytes = 96 * 1024;
 // reassociation. Non-finite gradients raise the guard. Not used on the fine levels (k_grid_backward,
 // one thread per point): there the points rarely share a cell and the merged form measured 1 % slower
 // (H200, results/cuda_training.md).
+// acc_s is feature-major (feature f of entry e at f * entries + e): with the 4 features of an entry in
+// consecutive words, the lanes' random entries fell on 8 bank groups (ncu on the H200: 44 % of the
+// kernel's shared wavefronts were conflict replays).
 __device__ void coarse_backward_sample_level(const GpuHashLevel& lv, const DevBatch& b, uint32_t i, uint32_t l,
-                                             uint32_t* flag, float* acc_s) {
+                                             uint32_t* flag, float* acc_s, uint32_t entries) {
     uvec3 cell[NB_SEGMENT_POINTS];
     vec3 frac[NB_SEGMENT_POINTS];
     float4 df[NB_SEGMENT_POINTS];
@@ -122,11 +125,11 @@ __device__ void coarse_backward_sample_level(const GpuHashLevel& lv, const DevBa
                 v.z += w * df[j].z;
                 v.w += w * df[j].w;
             }
-            float* dst = acc_s + size_t(nb_grid_corner_entry(lv, cell[k], c)) * 4; // coarse levels start at entry 0
-            atomicAdd(dst + 0, v.x);
-            atomicAdd(dst + 1, v.y);
-            atomicAdd(dst + 2, v.z);
-            atomicAdd(dst + 3, v.w);
+            float* dst = acc_s + nb_grid_corner_entry(lv, cell[k], c); // coarse levels start at entry 0
+            atomicAdd(dst, v.x);
+            atomicAdd(dst + entries, v.y);
+            atomicAdd(dst + 2 * entries, v.z);
+            atomicAdd(dst + 3 * entries, v.w);
         }
     }
 }
@@ -138,16 +141,16 @@ __global__ void k_grid_backward_coarse(DevNetwork net, DevBatch b, uint32_t coar
     __syncthreads();
     // One thread per (sample, coarse level); the shared-memory atomics bound this kernel
     // (results/cuda_training.md), and merging the points of one cell cuts them by up to 3x.
-    const uint32_t items = b.n * coarse_levels;
+    const uint32_t items = b.n * coarse_levels, entries = coarse_values / 4;
     for (uint32_t t = blockIdx.x * blockDim.x + threadIdx.x; t < items; t += gridDim.x * blockDim.x) {
         const uint32_t i = t / coarse_levels, l = t % coarse_levels;
         if (b.leaf[i] < 0) continue;
-        coarse_backward_sample_level(net.levels[l], b, i, l, flag, acc_s);
+        coarse_backward_sample_level(net.levels[l], b, i, l, flag, acc_s, entries);
     }
     __syncthreads();
     // One float4 add per touched entry (coarse levels start at entry 0; coarse_values is a multiple of 4).
-    for (uint32_t e = threadIdx.x; e < coarse_values / 4; e += blockDim.x) {
-        const float4 v = reinterpret_cast<const float4*>(acc_s)[e];
+    for (uint32_t e = threadIdx.x; e < entries; e += blockDim.x) {
+        const float4 v = make_float4(acc_s[e], acc_s[e + entries], acc_s[e + 2 * entries], acc_s[e + 3 * entries]);
         if (v.x == 0.0f && v.y == 0.0f && v.z == 0.0f && v.w == 0.0f) continue;
 #if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900
         atomicAdd(reinterpret_cast<float4*>(net.grid_grad) + e, v);
