@@ -8,12 +8,13 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "engine/bvh/wide_bvh.h"
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/neural/adam.h"
 #include "engine/neural/losses.h"
-#include "trainer/cuda/cuda_core.h"
 #include "engine/scene/texture_sampler.h"
+#include "trainer/cuda/cuda_core.h"
 
 namespace nbvh {
 namespace {
@@ -52,7 +53,7 @@ cuda::CoreAsset flatten_asset(const TrainingAsset& asset) {
         a.node_children.push_back(base.nodes[i].left);
         a.node_children.push_back(base.nodes[i].right);
     }
-    a.mesh_nodes = to_gpu_layout(asset.mesh_bvh.bvh);
+    a.mesh_wide = to_wide_layout(asset.mesh_bvh.bvh);
     const Mesh& m = *asset.mesh;
     const Scene& scene = *asset.scene;
     const MeshBvh& mb = asset.mesh_bvh;

@@ -155,7 +155,7 @@ public:
         base_boxes_ = a.node_boxes;
         base_children_ = a.node_children;
         part_roots_ = a.part_roots;
-        mesh_nodes_.upload(a.mesh_nodes);
+        mesh_wide_.upload(a.mesh_wide);
         tri_v_.upload(a.tri_vertices);
         tri_n_.upload(a.tri_normals);
         tri_a_.upload(a.tri_albedo);
@@ -173,7 +173,7 @@ public:
             normal_maps_.upload(a.tri_normal_map);
             da_.normal_maps = normal_maps_.p;
         }
-        da_.mesh_nodes = a.mesh_nodes.empty() ? nullptr : mesh_nodes_.p;
+        da_.mesh_wide = a.mesh_wide.empty() ? nullptr : mesh_wide_.p;
         da_.tri_v = tri_v_.p; da_.tri_n = tri_n_.p; da_.tri_a = tri_a_.p; da_.tri_g = tri_g_.p;
         da_.tri_uv = tri_uv_.p; da_.tri_tex = tri_tex_.p; da_.texels = texels_.p; da_.tex_info = tex_info_.p;
         da_.srgb = srgb_.p;
@@ -468,7 +468,7 @@ private:
     DevBuf<int32_t> tri_tex_;
     DevBuf<TriCoverage> coverage_;
     DevBuf<TriNormalMap> normal_maps_;
-    DevBuf<GpuBvhNode> mesh_nodes_;
+    DevBuf<GpuWideNode> mesh_wide_;
     DevBuf<float> grid_w_, grid_m_, grid_v_, grid_grad_, mlp_w_, mlp_m_, mlp_v_, mlp_grad_, slices_;
     DevBuf<uint32_t> grid_t_, mlp_t_, leaf_samples_, flag_;
     DevBuf<__half> grid_h_, mlp_h_, b_feat_;

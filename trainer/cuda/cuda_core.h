@@ -8,10 +8,11 @@
 #include <array>
 #include <vector>
 
+#include "engine/neural/shared/training_loss.h"
 #include "shaders/shared/bvh_node.h"
 #include "shaders/shared/hashgrid.h"
 #include "shaders/shared/neural_query.h"
-#include "engine/neural/shared/training_loss.h"
+#include "shaders/shared/wide_bvh_node.h"
 
 namespace nbvh::cuda {
 
@@ -40,8 +41,9 @@ struct CoreAsset {
     // (cut_tree.h) whenever the cuts change.
     std::vector<float> node_boxes;      // 6 per node
     std::vector<uint32_t> node_children; // 2 per node
-    // Triangle BVH for the ground truth: GPU layout (leaf refs index triangles in leaf order).
-    std::vector<GpuBvhNode> mesh_nodes;
+    // Triangle BLAS for the ground truth: the renderer's 4-wide layout (to_wide_layout; leaf refs index
+    // triangles in leaf order).
+    std::vector<GpuWideNode> mesh_wide;
     std::vector<float> tri_vertices;    // 9 per triangle (leaf order)
     std::vector<float> tri_normals;     // 9 per triangle: unit vertex normals (leaf order)
     std::vector<float> tri_albedo;      // 9 per triangle: per-vertex base colour factor

@@ -29,7 +29,7 @@
 namespace nbvh::cuda {
 
 struct DevAsset {
-    const GpuBvhNode* mesh_nodes = nullptr;
+    const GpuWideNode* mesh_wide = nullptr; // the ground truth's triangle BLAS (4-wide)
     const float* tri_v = nullptr;        // 9 per triangle
     const float* tri_n = nullptr;        // 9 per triangle
     const float* tri_a = nullptr;        // 9 per triangle: base colour factor per vertex

@@ -3,9 +3,10 @@
 // of each sample by a closest-hit traversal of the asset's triangle BVH in the shared GpuBvhNode layout
 // with the shared ray/box and ray/triangle tests (shaders/shared/intersect.h).
 // Compiled with --fmad=false (CMakeLists.txt) so the ray set matches the CPU backend's for a seed.
+#include "shaders/shared/scene_gpu.h"
+#include "shaders/shared/wide_bvh_node.h"
 #include "trainer/cuda/clip_box.cuh"
 #include "trainer/cuda/device_common.cuh"
-#include "shaders/shared/scene_gpu.h"
 
 namespace nbvh::cuda {
 namespace {
@@ -201,24 +202,31 @@ __device__ vec3 load3(const float* p) { return vec3(p[0], p[1], p[2]); }
 // Triangle data through the read-only cache.
 __device__ vec3 ldg3(const float* p) { return vec3(__ldg(p), __ldg(p + 1), __ldg(p + 2)); }
 
-// A triangle-BVH node through the read-only cache in four 16-byte loads. GpuBvhNode is only 4-byte
-// aligned in C++ (vec3 members), so `a.mesh_nodes[node]` compiled to 14 scalar loads per node; the
-// buffer is cudaMalloc'd and a node is 64 bytes, so every node is 16-byte aligned. Ground truth 0.393 ->
-// 0.309 ms per 2^18 samples (H200, results/cuda_training.md).
-__device__ GpuBvhNode load_bvh_node(const GpuBvhNode* nodes, uint32_t i) {
-    const float4* q = reinterpret_cast<const float4*>(nodes + i);
-    const float4 a = __ldg(q), b = __ldg(q + 1), c = __ldg(q + 2), d = __ldg(q + 3);
-    GpuBvhNode n;
-    n.lmin = vec3(a.x, a.y, a.z);
-    n.left = __float_as_uint(a.w);
-    n.lmax = vec3(b.x, b.y, b.z);
-    n.right = __float_as_uint(b.w);
-    n.rmin = vec3(c.x, c.y, c.z);
-    n.pad0 = 0u;
-    n.rmax = vec3(d.x, d.y, d.z);
-    n.pad1 = 0u;
-    return n;
-}
+// The triangle BLAS's 4-wide nodes (shaders/shared/wide_bvh_node.h) through the read-only cache in four
+// 16-byte loads. GpuWideNode is only 4-byte aligned in C++ (vec3 members), so `nodes[i]` would compile
+// to 16 scalar loads (the binary nodes' copy did: results/cuda_training.md); the buffer is cudaMalloc'd
+// and a node is 64 bytes, so every node is 16-byte aligned. NB_TRAVERSE_WIDE indexes this like an array.
+struct WideNodes {
+    const GpuWideNode* p;
+    __device__ GpuWideNode operator[](uint32_t i) const {
+        const uint4* q = reinterpret_cast<const uint4*>(p + i);
+        const uint4 a = __ldg(q), b = __ldg(q + 1), c = __ldg(q + 2), d = __ldg(q + 3);
+        GpuWideNode n;
+        n.origin = vec3(__uint_as_float(a.x), __uint_as_float(a.y), __uint_as_float(a.z));
+        n.child0 = a.w;
+        n.scale = vec3(__uint_as_float(b.x), __uint_as_float(b.y), __uint_as_float(b.z));
+        n.child1 = b.w;
+        n.qlo_x = c.x;
+        n.qlo_y = c.y;
+        n.qlo_z = c.z;
+        n.child2 = c.w;
+        n.qhi_x = d.x;
+        n.qhi_y = d.y;
+        n.qhi_z = d.z;
+        n.child3 = d.w;
+        return n;
+    }
+};
 
 // The texel footprint of a bilinear lookup at (u, v): engine/scene/texture_sampler.cpp
 // sample_texture_bilinear (texel centres at +0.5, REPEAT wrap).
@@ -283,56 +291,29 @@ __device__ bool covers(const DevAsset& a, const TriCoverage& c, uint32_t p, floa
     return nb_alpha_covers(c.mode, surface_alpha(a, c, p, u, v), c.cutoff, key.coverage_bits(c.triangle));
 }
 
-// Walks the GpuBvhNode tree over [tmin, best] (nearest child first) and calls
-// crossing(p, tt, uu, vv, back_facing) for every triangle the ray crosses there (p in leaf order); a
-// crossing that returns true sets best = tt (later ones must be nearer).
+// Walks the asset's 4-wide BLAS over [tmin, best] (NB_TRAVERSE_WIDE, the renderer's own loop: nearest
+// child first) and calls crossing(p, tt, uu, vv, back_facing) for every triangle the ray crosses there
+// (p in leaf order: the wide layout keeps the binary BVH's leaves); a crossing that returns true sets
+// best = tt (later ones must be nearer). The CPU's ground truth walks the binary BVH: the same closest
+// crossing (up to exact ties in t), and where no crossing stops the ray (stop_probability) the same
+// crossings in another order. H200: ground truth 0.306 -> see results/cuda_training.md.
 template <class Crossing>
 __device__ void walk(const DevAsset& a, vec3 o, vec3 d, float tmin, float& best, Crossing crossing) {
     const vec3 inv = nb_safe_inv_dir(d);
-    uint32_t stack[NB_BVH_MAX_DEPTH + 2];
-    int top = 0;
-    uint32_t node = 0;
-    for (;;) {
-        const GpuBvhNode n = load_bvh_node(a.mesh_nodes, node);
-        float tl, tr;
-        const bool hl = n.left != NB_CHILD_NONE && nb_intersect_aabb(o, inv, n.lmin, n.lmax, tmin, best, tl);
-        const bool hr = n.right != NB_CHILD_NONE && nb_intersect_aabb(o, inv, n.rmin, n.rmax, tmin, best, tr);
-        uint32_t refs[2];
-        int cnt = 0;
-        // Leaves are tested right away; interior children are pushed (far first).
-        uint32_t inner[2];
-        float inner_t[2];
-        int ni = 0;
-        if (hl) refs[cnt++] = n.left;
-        if (hr) refs[cnt++] = n.right;
-        for (int k = 0; k < cnt; ++k) {
-            const uint32_t ref = refs[k];
-            if (nb_is_leaf(ref)) {
-                const uint32_t first = nb_leaf_first(ref), count = nb_leaf_count(ref);
-                for (uint32_t p = first; p < first + count; ++p) {
-                    const float* tv = a.tri_v + size_t(p) * 9;
-                    const vec3 v0 = ldg3(tv), v1 = ldg3(tv + 3), v2 = ldg3(tv + 6);
-                    float tt, uu, vv;
-                    if (nb_intersect_triangle(o, d, v0, v1, v2, tmin, best, tt, uu, vv) &&
-                        crossing(p, tt, uu, vv, nb_back_facing(v0, v1, v2, d)))
-                        best = tt;
-                }
-            } else {
-                inner[ni] = ref;
-                inner_t[ni++] = (ref == n.left) ? tl : tr;
-            }
+    const WideNodes nodes{a.mesh_wide};
+    const bool done = false;
+    float t_min = tmin;
+    auto leaf = [&](uint32_t first, uint32_t count) {
+        for (uint32_t p = first; p < first + count; ++p) {
+            const float* tv = a.tri_v + size_t(p) * 9;
+            const vec3 v0 = ldg3(tv), v1 = ldg3(tv + 3), v2 = ldg3(tv + 6);
+            float tt, uu, vv;
+            if (nb_intersect_triangle(o, d, v0, v1, v2, tmin, best, tt, uu, vv) &&
+                crossing(p, tt, uu, vv, nb_back_facing(v0, v1, v2, d)))
+                best = tt;
         }
-        if (ni == 2) {
-            const bool swap = inner_t[1] < inner_t[0];
-            const uint32_t nearer = swap ? inner[1] : inner[0], farther = swap ? inner[0] : inner[1];
-            if (top < int(NB_BVH_MAX_DEPTH + 2)) stack[top++] = farther;
-            node = nearer;
-            continue;
-        }
-        if (ni == 1) { node = inner[0]; continue; }
-        if (top == 0) break;
-        node = stack[--top];
-    }
+    };
+    NB_TRAVERSE_WIDE(nodes, 0u, o, inv, t_min, best, done, leaf)
 }
 
 // Closest hit in [tmin, tmax] that alpha keeps (trainer/ground_truth.cpp closest_triangle_hit).
@@ -424,9 +405,9 @@ __global__ void k_ground_truth(DevAsset a, DevBatch b, uint64_t seed, uint32_t s
         uint32_t tri = 0;
         bool blended = false;
         const bool drawn =
-            a.mesh_nodes && closest_hit(a, o, d, 0.0f, len, SampleSlot{seed, step, i}, t, tri, u, v, blended);
+            a.mesh_wide && closest_hit(a, o, d, 0.0f, len, SampleSlot{seed, step, i}, t, tri, u, v, blended);
         float visibility = drawn ? 1.0f : 0.0f;
-        if (a.mesh_nodes && a.coverage && blended) { // soft target: the stop probability (ground_truth.h)
+        if (a.mesh_wide && a.coverage && blended) { // soft target: the stop probability (ground_truth.h)
             float nt, nu, nv;
             uint32_t ntri = 0;
             visibility = stop_probability(a, o, d, 0.0f, len, nt, ntri, nu, nv);
