@@ -11,6 +11,8 @@
 namespace nbvh::cuda {
 namespace {
 
+struct Found { int32_t leaf; float t_entry, t_exit; };
+
 // A node of a cut tree through the read-only cache: box and children (cut_tree.h).
 struct LoadedNode {
     float lo[3], hi[3];
@@ -22,53 +24,35 @@ __device__ inline LoadedNode load_node(const CutNode* nodes, uint32_t i) {
     return LoadedNode{{a.x, a.y, a.z}, {a.w, __uint_as_float(b.x), __uint_as_float(b.y)}, b.z, b.w};
 }
 
-constexpr int kWalkStack = int(NB_BVH_MAX_DEPTH * 2 + 2);
-
-// first_leaf_of_cut (trainer/training_rays.cpp) as a resumable walk: nearest-first descent from a part's
-// root, stopping at cut leaves, on the cut's compact tree; `step` runs one iteration of the CPU's loop
-// (one popped node), so a warp's lanes can each be at another point of their own walks. Same nodes in
-// the same order as the CPU's walk of the base BVH, so the same leaf.
-struct LeafWalk {
-    uint32_t st_node[kWalkStack];
-    float st_t[kWalkStack];
+// first_leaf_of_cut (trainer/training_rays.cpp): nearest-first descent from a part's root, stopping at
+// cut leaves, on the cut's compact tree. Same nodes in the same order as the CPU's walk of the base BVH.
+__device__ Found first_leaf(const CutNode* nodes, uint32_t root, vec3 o, vec3 d, float dilation, float min_exit) {
+    Found best{-1, 0.0f, 0.0f};
+    if (root == kCutNone) return best; // empty base BVH
+    const InvDir id = inv_dir(d);
+    float best_entry = NB_INF;
+    uint32_t st_node[NB_BVH_MAX_DEPTH * 2 + 2];
+    float st_t[NB_BVH_MAX_DEPTH * 2 + 2];
     int top = 0;
-    int32_t leaf = -1; // the best leaf so far and its clip
-    float t_entry = 0.0f, t_exit = 0.0f, best_entry = NB_INF;
-    vec3 o, d;
-    InvDir id;
-    float dilation = 0.0f, min_exit = 0.0f;
-
-    __device__ void begin(const CutNode* nodes, uint32_t root) {
-        top = 0;
-        leaf = -1;
-        best_entry = NB_INF;
-        if (root == kCutNone) return; // empty base BVH
-        id = inv_dir(d);
-        float t0, t1;
-        const LoadedNode n = load_node(nodes, root);
-        if (!clip_dilated(n.lo, n.hi, o, d, id, dilation, t0, t1) || t1 <= min_exit) return;
-        st_node[0] = root;
-        st_t[0] = t0;
-        top = 1;
-    }
-    __device__ bool done() const { return top == 0; }
-    __device__ void step(const CutNode* nodes) {
+    float t0, t1;
+    LoadedNode n = load_node(nodes, root);
+    if (!clip_dilated(n.lo, n.hi, o, d, id, dilation, t0, t1) || t1 <= min_exit) return best;
+    st_node[top] = root;
+    st_t[top++] = t0;
+    while (top > 0) {
         --top;
         const uint32_t node = st_node[top];
         const float te = st_t[top];
-        if (te >= best_entry) return;
-        const LoadedNode n = load_node(nodes, node);
-        float t0, t1;
+        if (te >= best_entry) continue;
+        n = load_node(nodes, node);
         if (n.right == kCutLeafTag) {
             float ea = 0.0f, eb = 0.0f;
             clip_dilated(n.lo, n.hi, o, d, id, dilation, ea, eb);
-            leaf = int32_t(n.left);
-            t_entry = ea;
-            t_exit = eb;
+            best = Found{int32_t(n.left), ea, eb};
             best_entry = te;
-            return;
+            continue;
         }
-        if (n.left == kCutNone && n.right == kCutNone) return; // base leaf below no cut leaf
+        if (n.left == kCutNone && n.right == kCutNone) continue; // base leaf below no cut leaf
         uint32_t kn[2];
         float kt[2];
         int count = 0;
@@ -86,45 +70,47 @@ struct LeafWalk {
             const uint32_t m = kn[0]; kn[0] = kn[1]; kn[1] = m;
             const float t = kt[0]; kt[0] = kt[1]; kt[1] = t;
         }
-        if (top + count > kWalkStack) {
-            top = 0;
-            return;
-        } // cannot happen for a valid BVH
+        if (top + count > int(NB_BVH_MAX_DEPTH * 2 + 2)) return best; // cannot happen for a valid BVH
         for (int k = 0; k < count; ++k) {
             st_node[top] = kn[k];
             st_t[top++] = kt[k];
         }
     }
+    return best;
+}
+
+// One attempt of a slot: the body of the CPU loop (cpu_backend.cpp draw_training_sample), on the
+// attempt's own stream (trainer/pcg32.h SampleSlot).
+struct Attempt {
+    Found f;
+    uint32_t cut;
+    bool kept;
+    vec3 o, d;
 };
 
-// The draws of one attempt of a slot before its walk: the body of the CPU loop (cpu_backend.cpp
-// draw_training_sample) on the attempt's own stream (trainer/pcg32.h SampleSlot), up to the first-leaf
-// search. `rng` continues after it (the survival roulette's draw); `root` is the walk's start.
-struct AttemptRay {
-    Pcg32 rng{0, 0};
-    uint32_t cut = 0, root = kCutNone;
-    vec3 o, d;
-    float dilation = 0.0f;
-};
-__device__ AttemptRay attempt_ray(const DevAsset& a, const DevCuts& c, const SampleSlot& where,
-                                  uint32_t attempt) {
-    AttemptRay r;
-    r.rng = where.attempt_rng(attempt);
-    r.cut = c.count > 1 ? min(uint32_t(r.rng.next_float() * float(c.count)), c.count - 1u) : 0u;
+__device__ Attempt try_attempt(const DevAsset& a, const DevCuts& c, const SampleSlot& where, uint32_t attempt) {
+    Pcg32 rng = where.attempt_rng(attempt);
+    Attempt r;
+    r.cut = c.count > 1 ? min(uint32_t(rng.next_float() * float(c.count)), c.count - 1u) : 0u;
     // The part (trainer/training_asset.h pick_part; drawn only when there are several).
-    const uint32_t pi = a.parts > 1 ? min(uint32_t(r.rng.next_float() * float(a.parts)), a.parts - 1u) : 0u;
+    const uint32_t pi = a.parts > 1 ? min(uint32_t(rng.next_float() * float(a.parts)), a.parts - 1u) : 0u;
     const float* pb = a.part_boxes + size_t(pi) * 6;
     // The CPU evaluates glm::vec3(f(), f(), f()) and uniform_sphere_direction(f(), f()) arguments
     // right to left (g++): z first, then y, then x; u2 before u1.
-    const float rz = r.rng.next_float(), ry = r.rng.next_float(), rx = r.rng.next_float();
+    const float rz = rng.next_float(), ry = rng.next_float(), rx = rng.next_float();
     r.o = vec3(pb[0] + pb[3] * rx, pb[1] + pb[4] * ry, pb[2] + pb[5] * rz);
-    const float u2 = r.rng.next_float(), u1 = r.rng.next_float();
+    const float u2 = rng.next_float(), u1 = rng.next_float();
     const float phi = 2.0f * 3.14159265358979323846f * u1;
     const float cos_theta = 2.0f * u2 - 1.0f;
     const float sin_theta = sqrtf(fmaxf(0.0f, 1.0f - cos_theta * cos_theta));
     r.d = vec3(sin_theta * cosf(phi), sin_theta * sinf(phi), cos_theta);
-    r.dilation = 1e-5f + 1e-4f * r.rng.next_float();
-    r.root = c.roots[r.cut * a.parts + pi];
+    const float dilation = 1e-5f + 1e-4f * rng.next_float();
+    r.f = first_leaf(c.nodes, c.roots[r.cut * a.parts + pi], r.o, r.d, dilation, a.min_exit);
+    r.kept = r.f.leaf >= 0;
+    if (r.kept && r.cut == 0) {
+        const float keep = c.keep[r.f.leaf];
+        r.kept = !(keep < 1.0f && rng.next_float() >= keep);
+    }
     return r;
 }
 
@@ -136,125 +122,70 @@ __device__ void write_sample(const DevBatch& b, uint32_t i, vec3 so, vec3 sd, fl
     b.cut[i] = cut;
 }
 
+// Lanes l in [0, 32) with l % n == r.
+__device__ uint32_t lanes_of_rank(uint32_t r, uint32_t n) {
+    uint32_t m = 0u;
+    for (uint32_t l = r; l < 32u; l += n) m |= 1u << l;
+    return m;
+}
+
+// Position of the (k+1)-th set bit of m (m has more than k set bits).
+__device__ uint32_t nth_set_bit(uint32_t m, uint32_t k) {
+    for (uint32_t j = 0; j < k; ++j) m &= m - 1u;
+    return uint32_t(__ffs(int(m)) - 1);
+}
+
 constexpr uint32_t kFullWarp = 0xFFFFFFFFu;
+
+// Each lane owns one slot; a warp resolves its 32 slots together. Per round the n slots still open
+// share the 32 lanes (lane l tries attempt next[slot] + l / n of the (l % n)-th open slot), so a slot
+// that needs many redraws gets the lanes of the slots already done instead of leaving them idle (the
+// per-slot loop this replaces cost a warp its slowest slot's redraw count). A slot's sample is its
+// first kept attempt and only attempts up to it count as draws: the CPU loop's result, bit for bit.
 constexpr uint32_t kSampleBlock = 128; // whole warps: k_sample's lanes cooperate with full-mask intrinsics
 static_assert(kSampleBlock % 32u == 0u, "k_sample needs whole warps");
-constexpr uint32_t kSampleWarps = kSampleBlock / 32u;
-// Attempts of one slot that may be in flight or unresolved at once (the slot's window).
-constexpr uint32_t kWindow = 16;
-// A warp refills its idle lanes (and records their finished attempts) once this many are idle.
-constexpr uint32_t kRefillIdle = 8;
-// A finished attempt in its slot's window: bit 31 done, bit 30 kept, bits 27..29 cut, bits 0..26 leaf + 1.
-constexpr uint32_t kWinDone = 1u << 31, kWinKept = 1u << 30;
-static_assert(NB_CUDA_MAX_CUTS <= 8, "the window packs the cut in 3 bits");
 
-// Each lane owns one slot; a warp resolves its 32 slots together, and its lanes are shared among the
-// slots still open: a lane whose walk ends takes the next attempt of an open slot (attempts handed out
-// in order per slot), so no lane waits for another lane's longer walk, only for the next refill (a
-// walk that ends is recorded at the next refill, when kRefillIdle lanes are idle). A slot's sample is
-// its first kept attempt and only attempts up to it count as draws (and leaf draws): each slot keeps
-// its finished attempts in a window of kWindow, in shared memory, and its owner resolves them in
-// attempt order: the CPU loop's result, bit for bit. Attempts handed out past the kept one are
-// dropped. (The round-based form this replaces made every lane wait for the warp's longest walk: 8 of
-// 32 lanes active on average, Nsight Compute on the H200: results/cuda_training_ncu_h200.txt.)
-__global__ void __launch_bounds__(kSampleBlock)
-    k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint64_t seed, uint32_t step,
-             unsigned long long* draws_total, uint32_t* valid_total) {
-    __shared__ uint32_t win_all[kSampleWarps][32][kWindow];
-    __shared__ float2 clip_all[kSampleWarps][32][kWindow]; // (t_entry, t_exit) of kept attempts
-    const uint32_t lane = threadIdx.x & 31u, warp = threadIdx.x / 32u;
-    uint32_t(*win)[kWindow] = win_all[warp];
-    float2(*clip)[kWindow] = clip_all[warp];
+__global__ void k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint64_t seed, uint32_t step,
+                         unsigned long long* draws_total, uint32_t* valid_total) {
+    const uint32_t lane = threadIdx.x & 31u;
     const uint32_t slot = blockIdx.x * blockDim.x + threadIdx.x;
     const uint32_t warp_base = slot - lane;
-    for (uint32_t k = 0; k < kWindow; ++k) win[lane][k] = 0u;
-    // As the owner of `slot`: open, attempts handed out, attempts resolved.
-    bool open = slot < batch;
-    uint32_t next = 0, base = 0;
+    bool open = slot < batch; // as the owner of `slot`
+    uint32_t next = 0;        // as the owner: attempts taken so far
     uint32_t drawn = 0, valid = 0;
-    // As a worker: the attempt this lane walks.
-    bool busy = false, finished = false, kept = false;
-    uint32_t sidx = 0, attempt = 0;
-    AttemptRay ray;
-    LeafWalk w;
-    __syncwarp();
     for (;;) {
-        const uint32_t idle = __ballot_sync(kFullWarp, !busy || finished);
-        if (uint32_t(__popc(idle)) >= kRefillIdle) {
-            // 1. Finished attempts into their slots' windows (dropped if the slot resolved meanwhile).
-            const bool slot_open = __shfl_sync(kFullWarp, open, sidx);
-            if (busy && finished && slot_open) {
-                win[sidx][attempt % kWindow] =
-                    kWinDone | (kept ? kWinKept : 0u) | (ray.cut << 27) | uint32_t(w.leaf + 1);
-                if (kept) clip[sidx][attempt % kWindow] = make_float2(w.t_entry, w.t_exit);
-            }
-            if (finished) busy = false;
-            __syncwarp();
-            // 2. Owners resolve their windows in attempt order.
-            while (open && base < next) {
-                const uint32_t e = win[lane][base % kWindow];
-                if (!(e & kWinDone)) break;
-                win[lane][base % kWindow] = 0u;
-                const int32_t leaf = int32_t(e & 0x07FFFFFFu) - 1;
-                const uint32_t cut = (e >> 27) & 7u;
-                drawn++;
-                if (cut == 0u && leaf >= 0) atomicAdd(&c.leaf_draws[leaf], 1u);
-                if (e & kWinKept) {
-                    const AttemptRay r = attempt_ray(a, c, SampleSlot{seed, step, slot}, base);
-                    const float2 t = clip[lane][base % kWindow];
-                    write_sample(b, slot, r.o + r.d * t.x, r.d, fmaxf(t.y - t.x, 0.0f), leaf, cut);
-                    open = false;
-                    valid++;
-                }
-                base++;
-            }
-            if (open && base >= kMaxSampleAttempts) { // starved: no reachable leaf
-                open = false;
-                write_sample(b, slot, vec3(0.0f), vec3(0.0f), 0.0f, -1, 0u);
-            }
-            __syncwarp();
-            // 3. Idle lanes take the next attempts of the open slots with room in their windows: the
-            // r-th idle lane serves the (r mod n)-th such slot, its (r / n)-th next attempt.
-            const uint32_t room_end = min(base + kWindow, kMaxSampleAttempts);
-            const bool has_room = open && next < room_end;
-            const uint32_t avail = __ballot_sync(kFullWarp, has_room);
-            const uint32_t free_mask = __ballot_sync(kFullWarp, !busy);
-            if (avail == 0u && free_mask == kFullWarp) break; // every slot resolved
-            const uint32_t n = uint32_t(__popc(avail)), nfree = uint32_t(__popc(free_mask));
-            if (n > 0u) {
-                const uint32_t r = uint32_t(__popc(free_mask & ((1u << lane) - 1u)));
-                const uint32_t q = busy ? 0u : r % n;
-                const uint32_t owner = __fns(avail, 0u, int(q) + 1);
-                const uint32_t owner_next = __shfl_sync(kFullWarp, next, owner);
-                const uint32_t owner_room = __shfl_sync(kFullWarp, room_end, owner);
-                if (!busy && owner_next + r / n < owner_room) {
-                    busy = true;
-                    finished = false;
-                    sidx = owner;
-                    attempt = owner_next + r / n;
-                    ray = attempt_ray(a, c, SampleSlot{seed, step, warp_base + sidx}, attempt);
-                    w.o = ray.o;
-                    w.d = ray.d;
-                    w.dilation = ray.dilation;
-                    w.min_exit = a.min_exit;
-                    w.begin(c.nodes, ray.root);
-                }
-                if (has_room) { // as an owner: the attempts just handed out
-                    const uint32_t my_q = uint32_t(__popc(avail & ((1u << lane) - 1u)));
-                    const uint32_t given = my_q < nfree ? (nfree - my_q + n - 1u) / n : 0u;
-                    next = min(next + given, room_end);
-                }
-            }
+        const uint32_t open_mask = __ballot_sync(kFullWarp, open);
+        if (open_mask == 0u) break;
+        const uint32_t n = uint32_t(__popc(open_mask));
+        // As an attempter: which slot, which attempt.
+        const uint32_t rank = lane % n;
+        const uint32_t owner = nth_set_bit(open_mask, rank);
+        const uint32_t attempt = __shfl_sync(kFullWarp, next, owner) + lane / n;
+        const bool active = attempt < kMaxSampleAttempts;
+        Attempt r{};
+        if (active) r = try_attempt(a, c, SampleSlot{seed, step, warp_base + owner}, attempt);
+        const bool success = active && r.kept;
+        const uint32_t wins = __ballot_sync(kFullWarp, success);
+        const uint32_t mine = wins & lanes_of_rank(rank, n);
+        const uint32_t first = mine ? uint32_t(__ffs(int(mine)) - 1) : 32u;
+        if (active && lane <= first) { // attempts up to the slot's first kept one count
+            drawn++;
+            if (r.cut == 0u && r.f.leaf >= 0) atomicAdd(&c.leaf_draws[r.f.leaf], 1u);
         }
-        // 4. One node of every walk in progress; a walk that ends decides its attempt.
-        if (busy && !finished) {
-            if (!w.done()) w.step(c.nodes);
-            if (w.done()) {
-                finished = true;
-                kept = w.leaf >= 0;
-                if (kept && ray.cut == 0u) {
-                    const float keep = c.keep[w.leaf];
-                    kept = !(keep < 1.0f && ray.rng.next_float() >= keep);
+        if (success && lane == first)
+            write_sample(b, warp_base + owner, r.o + r.d * r.f.t_entry, r.d, fmaxf(r.f.t_exit - r.f.t_entry, 0.0f),
+                         r.f.leaf, r.cut);
+        if (open) { // as the owner: done, or the attempts this round took
+            const uint32_t my_rank = uint32_t(__popc(open_mask & ((1u << lane) - 1u)));
+            const uint32_t lanes = lanes_of_rank(my_rank, n);
+            if (wins & lanes) {
+                open = false;
+                valid++;
+            } else {
+                next += uint32_t(__popc(lanes));
+                if (next >= kMaxSampleAttempts) { // starved: no reachable leaf
+                    open = false;
+                    write_sample(b, slot, vec3(0.0f), vec3(0.0f), 0.0f, -1, 0u);
                 }
             }
         }
