@@ -138,18 +138,10 @@ __device__ uint32_t nth_set_bit(uint32_t m, uint32_t k) {
 constexpr uint32_t kFullWarp = 0xFFFFFFFFu;
 
 // Each lane owns one slot; a warp resolves its 32 slots together. Per round the n slots still open
-// share the 32 lanes: lane l runs attempts next[slot] + (l / n) * kSampleRun + 0, 1, ... of the
-// (l % n)-th open slot, one after the other, up to kSampleRun of them and stopping at its first kept
-// one. So a slot that needs many redraws gets the lanes of the slots already done instead of leaving
-// them idle (the per-slot loop this replaced cost a warp its slowest slot's redraw count), and a round
-// waits for the longest of the lanes' runs of a few walks rather than for the longest single walk
-// (one attempt per lane and round left 8 of 32 lanes active on average: Nsight Compute on the H200,
-// results/cuda_training_ncu_h200.txt). A slot's sample is its first kept attempt and only attempts up
-// to it count as draws: the CPU loop's result, bit for bit.
-#ifndef NB_SAMPLE_RUN
-#define NB_SAMPLE_RUN 4u
-#endif
-constexpr uint32_t kSampleRun = NB_SAMPLE_RUN;
+// share the 32 lanes (lane l tries attempt next[slot] + l / n of the (l % n)-th open slot), so a slot
+// that needs many redraws gets the lanes of the slots already done instead of leaving them idle (the
+// per-slot loop this replaces cost a warp its slowest slot's redraw count). A slot's sample is its
+// first kept attempt and only attempts up to it count as draws: the CPU loop's result, bit for bit.
 constexpr uint32_t kSampleBlock = 128; // whole warps: k_sample's lanes cooperate with full-mask intrinsics
 static_assert(kSampleBlock % 32u == 0u, "k_sample needs whole warps");
 
@@ -165,29 +157,20 @@ __global__ void k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint
         const uint32_t open_mask = __ballot_sync(kFullWarp, open);
         if (open_mask == 0u) break;
         const uint32_t n = uint32_t(__popc(open_mask));
-        // As an attempter: which slot, which attempts (a run of up to kSampleRun, stopping at a kept one).
+        // As an attempter: which slot, which attempt.
         const uint32_t rank = lane % n;
         const uint32_t owner = nth_set_bit(open_mask, rank);
-        const uint32_t first_attempt = __shfl_sync(kFullWarp, next, owner) + (lane / n) * kSampleRun;
-        int32_t
-            leaves[kSampleRun]; // each attempt's leaf of cuts[0] (-1: none or another cut), for leaf_draws
-        uint32_t ran = 0;
-        bool success = false;
+        const uint32_t attempt = __shfl_sync(kFullWarp, next, owner) + lane / n;
+        const bool active = attempt < kMaxSampleAttempts;
         Attempt r{};
-        for (uint32_t k = 0; k < kSampleRun && first_attempt + k < kMaxSampleAttempts && !success; ++k) {
-            r = try_attempt(a, c, SampleSlot{seed, step, warp_base + owner}, first_attempt + k);
-            leaves[k] = r.cut == 0u ? r.f.leaf : -1;
-            ran = k + 1;
-            success = r.kept;
-        }
+        if (active) r = try_attempt(a, c, SampleSlot{seed, step, warp_base + owner}, attempt);
+        const bool success = active && r.kept;
         const uint32_t wins = __ballot_sync(kFullWarp, success);
         const uint32_t mine = wins & lanes_of_rank(rank, n);
         const uint32_t first = mine ? uint32_t(__ffs(int(mine)) - 1) : 32u;
-        if (lane <=
-            first) { // attempts up to the slot's first kept one count (earlier lanes ran earlier attempts)
-            drawn += ran;
-            for (uint32_t k = 0; k < ran; ++k)
-                if (leaves[k] >= 0) atomicAdd(&c.leaf_draws[leaves[k]], 1u);
+        if (active && lane <= first) { // attempts up to the slot's first kept one count
+            drawn++;
+            if (r.cut == 0u && r.f.leaf >= 0) atomicAdd(&c.leaf_draws[r.f.leaf], 1u);
         }
         if (success && lane == first)
             write_sample(b, warp_base + owner, r.o + r.d * r.f.t_entry, r.d, fmaxf(r.f.t_exit - r.f.t_entry, 0.0f),
@@ -199,7 +182,7 @@ __global__ void k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint
                 open = false;
                 valid++;
             } else {
-                next += kSampleRun * uint32_t(__popc(lanes));
+                next += uint32_t(__popc(lanes));
                 if (next >= kMaxSampleAttempts) { // starved: no reachable leaf
                     open = false;
                     write_sample(b, slot, vec3(0.0f), vec3(0.0f), 0.0f, -1, 0u);
