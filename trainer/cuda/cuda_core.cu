@@ -120,10 +120,6 @@ struct BatchSlot {
     DevBuf<float> origin, dir, len, target, points, keep;
     DevBuf<int32_t> leaf;
     DevBuf<uint32_t> cut, leaf_draws, scalars; // scalars: [0..1] draws (u64), [2] valid samples
-    // The ground truth's sample order (launch_leaf_order): sort keys, their sorted copy, the identity,
-    // the permutation, CUB's scratch.
-    DevBuf<uint32_t> order_keys, order_keys_sorted, order_iota, order;
-    DevBuf<unsigned char> order_temp;
     float* keep_host = nullptr;                // pinned staging of the keep probabilities it was drawn with
     size_t keep_host_n = 0;
     cudaEvent_t ready{};                       // recorded after its ground truth
@@ -235,8 +231,6 @@ public:
         cut_roots_.upload(roots);
         cut_count_ = uint32_t(cuts.size());
         leaves_ = cuts[0].leaves;
-        max_leaves_ = 0;
-        for (const CoreCut& c : cuts) max_leaves_ = std::max(max_leaves_, c.leaves);
         leaf_samples_.alloc(leaves_);
         leaf_loss_fx_.alloc(leaves_);
     }
@@ -442,22 +436,7 @@ private:
         if (st == stream_) record(0);
         launch_sample(da_, dc, b.batch, n, seed, step, b.draws(), b.valid(), st);
         if (st == stream_) record(1);
-        LeafOrder order{};
-        order.leaf_bits = 1;
-        while (order.leaf_bits < 24 && (1ull << order.leaf_bits) <= max_leaves_) order.leaf_bits++;
-        b.order_keys.alloc(n);
-        b.order_keys_sorted.alloc(n);
-        b.order_iota.alloc(n);
-        b.order.alloc(n);
-        order.temp_bytes = leaf_order_temp_bytes(n, order.leaf_bits);
-        b.order_temp.alloc(order.temp_bytes);
-        order.keys = b.order_keys.p;
-        order.keys_sorted = b.order_keys_sorted.p;
-        order.iota = b.order_iota.p;
-        order.order = b.order.p;
-        order.temp = b.order_temp.p;
-        launch_leaf_order(b.batch, order, st);
-        launch_ground_truth(da_, b.batch, seed, step, order.order, st);
+        launch_ground_truth(da_, b.batch, seed, step, st);
         if (st == stream_) record(2);
         NBVH_CUDA_CHECK(cudaEventRecord(b.ready, st));
         b.step = step;
@@ -469,7 +448,6 @@ private:
     CoreConfig cfg_;
     float scale_ = 128.0f, last_scale_ = 128.0f;
     uint32_t good_steps_ = 0, last_valid_ = 0;
-    uint32_t max_leaves_ = 0;        // the most leaves of any cut (the ground truth's sort key width)
     cudaStream_t stream_{}, side_{}; // network part; batches drawn ahead
     cudaEvent_t ev_[7]{};
     bool timing_ = false;

@@ -91,25 +91,8 @@ struct DevNetwork {
 // Launchers (sampling_kernels.cu, network_kernels.cu).
 void launch_sample(const DevAsset& a, const DevCuts& c, const DevBatch& b, uint32_t batch, uint64_t seed,
                    uint32_t step, unsigned long long* draws, uint32_t* valid, cudaStream_t s);
-// The order in which the ground truth walks a batch: its samples sorted by (cut, leaf), so that a warp's
-// rays start in the same N-BVH leaf and walk the same BLAS nodes (sampling_kernels.cu). Device buffers
-// of n entries each and CUB's scratch of temp_bytes (leaf_order_temp_bytes).
-struct LeafOrder {
-    uint32_t* keys = nullptr;
-    uint32_t* keys_sorted = nullptr;
-    uint32_t* iota = nullptr;
-    uint32_t* order = nullptr; // the permutation: the ground truth's thread t takes sample order[t]
-    void* temp = nullptr;
-    size_t temp_bytes = 0;
-    uint32_t leaf_bits = 1; // leaf + 1 < 2^leaf_bits; the cut above it (3 bits)
-};
-size_t leaf_order_temp_bytes(uint32_t n, uint32_t leaf_bits);
-void launch_leaf_order(const DevBatch& b, const LeafOrder& o, cudaStream_t s);
-// `seed`, `step`: the batch's (SampleSlot), for the stochastic coverage of blended surfaces; `order`:
-// the samples' order (launch_leaf_order) or null for batch order. Each sample's targets are the same
-// in any order.
-void launch_ground_truth(const DevAsset& a, const DevBatch& b, uint64_t seed, uint32_t step,
-                         const uint32_t* order, cudaStream_t s);
+// `seed`, `step`: the batch's (SampleSlot), for the stochastic coverage of blended surfaces.
+void launch_ground_truth(const DevAsset& a, const DevBatch& b, uint64_t seed, uint32_t step, cudaStream_t s);
 void launch_encode(const DevNetwork& net, const DevBatch& b, cudaStream_t s);
 struct LossParams {
     GpuLossConfig loss; // the composite loss (engine/neural/shared/training_loss.h)

@@ -5,8 +5,6 @@
 // Compiled with --fmad=false (CMakeLists.txt) so the ray set matches the CPU backend's for a seed.
 #include "shaders/shared/scene_gpu.h"
 #include "shaders/shared/wide_bvh_node.h"
-#include <cub/device/device_radix_sort.cuh>
-
 #include "trainer/cuda/clip_box.cuh"
 #include "trainer/cuda/device_common.cuh"
 
@@ -395,10 +393,9 @@ __device__ vec3 normal_mapped(const DevAsset& a, uint32_t p, float u, float v, v
     return nb_normal_map(n, t4, texel, nm.scale);
 }
 
-__global__ void k_ground_truth(DevAsset a, DevBatch b, uint64_t seed, uint32_t step, const uint32_t* order) {
-    const uint32_t t = blockIdx.x * blockDim.x + threadIdx.x;
-    if (t >= b.n) return;
-    const uint32_t i = order ? order[t] : t;
+__global__ void k_ground_truth(DevAsset a, DevBatch b, uint64_t seed, uint32_t step) {
+    const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= b.n) return;
     float tg[8] = {0, 0, 0, 0, 0, 0, 0, 0};
     const vec3 o = load3(b.origin + 3 * i), d = load3(b.dir + 3 * i);
     const float len = b.length[i];
@@ -459,37 +456,9 @@ void launch_sample(const DevAsset& a, const DevCuts& c, const DevBatch& b, uint3
     NBVH_CUDA_CHECK(cudaGetLastError());
 }
 
-void launch_ground_truth(const DevAsset& a, const DevBatch& b, uint64_t seed, uint32_t step,
-                         const uint32_t* order, cudaStream_t s) {
-    k_ground_truth<<<(b.n + 127) / 128, 128, 0, s>>>(a, b, seed, step, order);
+void launch_ground_truth(const DevAsset& a, const DevBatch& b, uint64_t seed, uint32_t step, cudaStream_t s) {
+    k_ground_truth<<<(b.n + 127) / 128, 128, 0, s>>>(a, b, seed, step);
     NBVH_CUDA_CHECK(cudaGetLastError());
-}
-
-// Sort keys of the ground truth's order: (cut, leaf + 1), starved samples (leaf -1) first.
-__global__ void k_leaf_keys(DevBatch b, uint32_t leaf_bits, uint32_t* keys, uint32_t* iota) {
-    const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= b.n) return;
-    const uint32_t leaf = uint32_t(b.leaf[i] + 1) & ((1u << leaf_bits) - 1u);
-    keys[i] = (min(b.cut[i], 7u) << leaf_bits) | leaf;
-    iota[i] = i;
-}
-
-size_t leaf_order_temp_bytes(uint32_t n, uint32_t leaf_bits) {
-    size_t bytes = 0;
-    NBVH_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(
-        nullptr, bytes, static_cast<const uint32_t*>(nullptr), static_cast<uint32_t*>(nullptr),
-        static_cast<const uint32_t*>(nullptr), static_cast<uint32_t*>(nullptr), int(n), 0,
-        int(leaf_bits) + 3));
-    return bytes;
-}
-
-void launch_leaf_order(const DevBatch& b, const LeafOrder& o, cudaStream_t s) {
-    if (b.n == 0) return;
-    k_leaf_keys<<<(b.n + 255) / 256, 256, 0, s>>>(b, o.leaf_bits, o.keys, o.iota);
-    NBVH_CUDA_CHECK(cudaGetLastError());
-    size_t bytes = o.temp_bytes;
-    NBVH_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(o.temp, bytes, o.keys, o.keys_sorted, o.iota, o.order,
-                                                    int(b.n), 0, int(o.leaf_bits) + 3, s));
 }
 
 } // namespace nbvh::cuda
