@@ -146,6 +146,7 @@ public:
         NBVH_CUDA_CHECK(cudaStreamCreate(&stream_));
         NBVH_CUDA_CHECK(cudaStreamCreateWithFlags(&side_, cudaStreamNonBlocking));
         for (auto& e : ev_) NBVH_CUDA_CHECK(cudaEventCreate(&e));
+        NBVH_CUDA_CHECK(cudaEventCreateWithFlags(&mlp_done_, cudaEventDisableTiming));
         for (BatchSlot& b : slots_) {
             NBVH_CUDA_CHECK(cudaEventCreateWithFlags(&b.ready, cudaEventDisableTiming));
             b.scalars.alloc(4);
@@ -213,6 +214,7 @@ public:
         cudaStreamSynchronize(side_);
         cudaStreamSynchronize(stream_);
         for (auto& e : ev_) cudaEventDestroy(e);
+        cudaEventDestroy(mlp_done_);
         cudaStreamDestroy(side_);
         cudaStreamDestroy(stream_);
     }
@@ -256,12 +258,6 @@ public:
         }
         for (BatchSlot& b : slots_) b.filled = false;
         BatchSlot& slot = slots_[cur];
-        // The next step's batch, drawn while this step's network part runs (not when timing the phases).
-        if (cfg_.prefetch && !timing_) {
-            BatchSlot& next = slots_[1 - cur];
-            draw_batch(next, in.step + 1, n, in.seed, *in.keep_probability, side_);
-            next.filled = true;
-        }
         DevBatch batch = slot.batch;
         batch.features = b_feat_.p;
         batch.dfeatures = b_dfeat_.p;
@@ -283,6 +279,17 @@ public:
         const LossParams lp{cfg_.loss, scale_};
         launch_mlp(net_, batch, lp, slices_.p, blocks, flag, s);
         record(4);
+        // The next step's batch, drawn while this step's grid backward and Adam run (not when timing the
+        // phases): the sampler is bound by its lanes' instructions, the grid backward by L2 reductions,
+        // so they share the SMs well, while the fused MLP holds every SM's registers and would only
+        // take turns with it (the draw was issued at the step's start until this change).
+        if (cfg_.prefetch && !timing_) {
+            NBVH_CUDA_CHECK(cudaEventRecord(mlp_done_, s));
+            NBVH_CUDA_CHECK(cudaStreamWaitEvent(side_, mlp_done_, 0));
+            BatchSlot& next = slots_[1 - cur];
+            draw_batch(next, in.step + 1, n, in.seed, *in.keep_probability, side_);
+            next.filled = true;
+        }
         launch_grid_backward(net_, batch, cfg_.deterministic, flag, s);
         record(5);
         const int sblocks = int((n + kStatsThreads - 1) / kStatsThreads);
@@ -450,6 +457,7 @@ private:
     uint32_t good_steps_ = 0, last_valid_ = 0;
     cudaStream_t stream_{}, side_{}; // network part; batches drawn ahead
     cudaEvent_t ev_[7]{};
+    cudaEvent_t mlp_done_{}; // the next batch's draw waits for this step's fused MLP
     bool timing_ = false;
     CoreTimings tm_;
     DevAsset da_{};
