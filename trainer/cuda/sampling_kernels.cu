@@ -1,6 +1,6 @@
 // Training-ray generation with the first-leaf search over the current N-BVH cut (paper §3, §3.3;
 // mirrors trainer/training_rays.cpp and cpu_backend.cpp draw_training_sample), and the ground truth
-// of each sample by a closest-hit traversal of the asset's triangle BVH in the shared GpuBvhNode layout
+// of each sample by a closest-hit traversal of the asset's triangle BVH in the renderer's 4-wide layout
 // with the shared ray/box and ray/triangle tests (shaders/shared/intersect.h).
 // Compiled with --fmad=false (CMakeLists.txt) so the ray set matches the CPU backend's for a seed.
 #include "shaders/shared/scene_gpu.h"
