@@ -72,7 +72,7 @@ void expect_within_limits(uint64_t pixels, const RenderOptions& o, const WaveLim
 } // namespace
 
 // 16 samples of 1080p in one wave, classical and hybrid (2 leaves per round: each half of the pending
-// queue 2 x 48 bytes x 33.2M = 3.19 GB, within one allocation; ~17.7 GB of queues, within a quarter of 80).
+// queue 2 x 48 bytes x 33.2M = 3.19 GB, within one allocation; ~17.2 GB of queues, within a quarter of 80).
 TEST(WavePlan, FullHdTakesSixteenSamplesPerWaveOnALargeGpu) {
     const NeuralModel model;
     for (const NeuralModel* m : {static_cast<const NeuralModel*>(nullptr), &model}) {

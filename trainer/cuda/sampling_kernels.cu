@@ -302,7 +302,6 @@ __device__ void walk(const DevAsset& a, vec3 o, vec3 d, float tmin, float& best,
     const vec3 inv = nb_safe_inv_dir(d);
     const WideNodes nodes{a.mesh_wide};
     const bool done = false;
-    float t_min = tmin;
     auto leaf = [&](uint32_t first, uint32_t count) {
         for (uint32_t p = first; p < first + count; ++p) {
             const float* tv = a.tri_v + size_t(p) * 9;
@@ -313,7 +312,7 @@ __device__ void walk(const DevAsset& a, vec3 o, vec3 d, float tmin, float& best,
                 best = tt;
         }
     };
-    NB_TRAVERSE_WIDE(nodes, 0u, o, inv, t_min, best, done, leaf)
+    NB_TRAVERSE_WIDE(nodes, 0u, o, inv, tmin, best, done, leaf)
 }
 
 // Closest hit in [tmin, tmax] that alpha keeps (trainer/ground_truth.cpp closest_triangle_hit).
