@@ -1,7 +1,9 @@
 // Kernel of clip_box_kernels.h: one thread per case, inv_dir + clip_dilated exactly as k_sample's
-// first-leaf search calls them (on a box's lo and hi). Compiled with --fmad=false like sampling_kernels.cu (tests/cuda/CMakeLists.txt).
+// first-leaf search calls them (on a box's centre and half extent, from box_centre_half as the cut tree
+// stores them). Compiled with --fmad=false like sampling_kernels.cu (tests/cuda/CMakeLists.txt).
 #include "tests/cuda/clip_box_kernels.h"
 #include "trainer/cuda/clip_box.cuh"
+#include "trainer/cuda/cut_tree.h"
 
 namespace nbvh::test {
 namespace {
@@ -14,8 +16,8 @@ __global__ void k_clip(ClipCase* cases, const float* boxes, uint32_t n) {
     const cuda::InvDir id = cuda::inv_dir(d);
     float t0 = 0.0f, t1 = 0.0f;
     const float* b = boxes + 6 * size_t(i);
-    const float lo[3] = {b[0], b[1], b[2]}, hi[3] = {b[3], b[4], b[5]}; // a cut node's box (cut_tree.h)
-    c.hit = cuda::clip_dilated(lo, hi, o, d, id, c.dilation, t0, t1) ? 1u : 0u;
+    const float centre[3] = {b[0], b[1], b[2]}, half[3] = {b[3], b[4], b[5]}; // as a cut node holds it
+    c.hit = cuda::clip_dilated(centre, half, o, d, id, c.dilation, t0, t1) ? 1u : 0u;
     c.t_entry = c.hit ? t0 : 0.0f;
     c.t_exit = c.hit ? t1 : 0.0f;
 }
@@ -27,8 +29,9 @@ std::string error_of(cudaError_t e) { return e == cudaSuccess ? std::string() : 
 std::string clip_on_device(std::vector<ClipCase>& cases) {
     const uint32_t n = uint32_t(cases.size());
     std::vector<float> boxes(6 * size_t(n));
-    for (uint32_t i = 0; i < n; ++i)
-        for (int k = 0; k < 6; ++k) boxes[6 * size_t(i) + k] = cases[i].box[k];
+    for (uint32_t i = 0; i < n; ++i) // each box as the cut tree stores it (cut_tree.h)
+        cuda::box_centre_half(cases[i].box, cases[i].box + 3, &boxes[6 * size_t(i)],
+                              &boxes[6 * size_t(i) + 3]);
     ClipCase* dc = nullptr;
     float* db = nullptr;
     std::string err = error_of(cudaMalloc(&dc, n * sizeof(ClipCase)));

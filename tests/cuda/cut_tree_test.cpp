@@ -32,8 +32,8 @@ BaseArrays flatten(const TrainingAsset& a) { // as cuda_backend.cpp flatten_asse
     return f;
 }
 
-// Walks the base BVH and the compact tree together: same boxes, same children order, cut leaves carry
-// their slot and end the walk. Returns the compact nodes reached.
+// Walks the base BVH and the compact tree together: same boxes (as centre and half extent), same children
+// order, cut leaves carry their slot and end the walk. Returns the compact nodes reached.
 size_t check_isomorphic(const TrainingAsset& a, const TrainingCut& cut, const std::vector<CutNode>& nodes,
                         uint32_t base_root, uint32_t compact_root, std::vector<uint32_t>& leaves_seen) {
     std::vector<std::pair<uint32_t, uint32_t>> stack{{base_root, compact_root}};
@@ -46,8 +46,8 @@ size_t check_isomorphic(const TrainingAsset& a, const TrainingCut& cut, const st
         reached++;
         const CutNode& n = nodes[c];
         for (int k = 0; k < 3; ++k) {
-            EXPECT_EQ(n.lo[k], a.node_boxes[b].lo[k]);
-            EXPECT_EQ(n.hi[k], a.node_boxes[b].hi[k]);
+            EXPECT_EQ(n.centre[k], 0.5f * (a.node_boxes[b].lo[k] + a.node_boxes[b].hi[k]));
+            EXPECT_EQ(n.half[k], 0.5f * (a.node_boxes[b].hi[k] - a.node_boxes[b].lo[k]));
         }
         const int32_t slot = cut.leaf_of_base_node[b];
         if (slot >= 0) {
@@ -140,8 +140,8 @@ TEST(CutTree, OneChildNodesAndBaseLeavesBelowNoCutLeaf) {
     EXPECT_EQ(nodes[3].left, kCutNone);
     EXPECT_EQ(nodes[3].right, kCutNone);
     for (uint32_t i = 0; i < 4; ++i) {
-        EXPECT_EQ(nodes[i].lo[0], -float(i));
-        EXPECT_EQ(nodes[i].hi[0], float(i) + 1.0f);
+        EXPECT_EQ(nodes[i].centre[0], 0.5f); // box [-i, i + 1]
+        EXPECT_EQ(nodes[i].half[0], float(i) + 0.5f);
     }
 }
 

@@ -18,15 +18,17 @@ __device__ inline InvDir inv_dir(vec3 d) {
     return r;
 }
 
-// trainer/training_rays.cpp clip_line_to_box on a box dilated as dilate_box() (same float operations).
-__device__ inline bool clip_dilated(const float lo3[3], const float hi3[3], vec3 o, vec3 d, const InvDir& id,
-                                    float dilation, float& t_entry, float& t_exit) {
+// trainer/training_rays.cpp clip_line_to_box on a box dilated as dilate_box() (same float operations),
+// the box given by its centre and half extent (cut_tree.h box_centre_half, computed once per node on
+// the host: dilate_box's first steps, the same values). A negative half extent is an empty box.
+__device__ inline bool clip_dilated(const float centre[3], const float half_extent[3], vec3 o, vec3 d,
+                                    const InvDir& id, float dilation, float& t_entry, float& t_exit) {
     float t0 = -NB_INF, t1 = NB_INF;
+    const float grow = 1.0f + dilation;
     for (int a = 0; a < 3; ++a) {
-        const float blo = lo3[a], bhi = hi3[a];
-        if (blo > bhi) return false; // empty box
-        const float c = 0.5f * (blo + bhi);
-        const float half = 0.5f * (bhi - blo) * (1.0f + dilation);
+        if (half_extent[a] < 0.0f) return false; // empty box (lo > hi)
+        const float c = centre[a];
+        const float half = half_extent[a] * grow;
         const float lo = c - half, hi = c + half;
         if (!isfinite(lo) || !isfinite(hi)) return false;
         const float oa = o[a], da = d[a];

@@ -33,10 +33,7 @@ void append_cut_tree(const std::vector<float>& boxes, const std::vector<uint32_t
             if (e.side == 0) nodes[e.parent].left = me;
             if (e.side == 1) nodes[e.parent].right = me;
             CutNode n{};
-            for (int k = 0; k < 3; ++k) {
-                n.lo[k] = boxes[6 * size_t(e.node) + k];
-                n.hi[k] = boxes[6 * size_t(e.node) + 3 + k];
-            }
+            box_centre_half(&boxes[6 * size_t(e.node)], &boxes[6 * size_t(e.node) + 3], n.centre, n.half);
             n.left = n.right = kCutNone;
             const int32_t slot = leaf_of_base_node[e.node];
             if (slot >= 0) {

@@ -14,13 +14,24 @@ namespace nbvh::cuda {
 inline constexpr uint32_t kCutNone = 0xFFFFFFFFu;     // no child / no node
 inline constexpr uint32_t kCutLeafTag = 0xFFFFFFFEu;  // `right` of a cut leaf; `left` holds its slot
 
-// 32 bytes, read as two 16-byte loads: box (lo xyz, hi xyz) and the two children's compact indices
-// (kCutNone where absent; a base leaf below no cut leaf has none). A cut leaf: left = leaf slot,
+// 32 bytes, read as two 16-byte loads: the box as centre and half extent (box_centre_half: the first
+// two steps of the sampler's dilated clip, clip_box.cuh, done once here) and the two children's compact
+// indices (kCutNone where absent; a base leaf below no cut leaf has none). A cut leaf: left = leaf slot,
 // right = kCutLeafTag.
 struct alignas(16) CutNode {
-    float lo[3], hi[3];
+    float centre[3], half[3];
     uint32_t left, right;
 };
+
+// trainer/training_rays.cpp dilate_box's centre 0.5 (lo + hi) and half extent 0.5 (hi - lo), in the same
+// float operations (no FMA can contract them), so a clip from them is the CPU's to the bit. An empty
+// box (lo > hi) has a negative half extent; a NaN or infinite bound gives a NaN or infinite one.
+inline void box_centre_half(const float lo[3], const float hi[3], float centre[3], float half[3]) {
+    for (int k = 0; k < 3; ++k) {
+        centre[k] = 0.5f * (lo[k] + hi[k]);
+        half[k] = 0.5f * (hi[k] - lo[k]);
+    }
+}
 static_assert(sizeof(CutNode) == 32, "CutNode is two 16-byte loads");
 
 // Appends the compact tree of one cut to `nodes` and one root per part to `roots` (compact index, or

@@ -13,9 +13,9 @@ namespace {
 
 struct Found { int32_t leaf; float t_entry, t_exit; };
 
-// A node of a cut tree through the read-only cache: box and children (cut_tree.h).
+// A node of a cut tree through the read-only cache: box (centre, half extent) and children (cut_tree.h).
 struct LoadedNode {
-    float lo[3], hi[3];
+    float centre[3], half[3];
     uint32_t left, right;
 };
 __device__ inline LoadedNode load_node(const CutNode* nodes, uint32_t i) {
@@ -36,7 +36,7 @@ __device__ Found first_leaf(const CutNode* nodes, uint32_t root, vec3 o, vec3 d,
     int top = 0;
     float t0, t1;
     LoadedNode n = load_node(nodes, root);
-    if (!clip_dilated(n.lo, n.hi, o, d, id, dilation, t0, t1) || t1 <= min_exit) return best;
+    if (!clip_dilated(n.centre, n.half, o, d, id, dilation, t0, t1) || t1 <= min_exit) return best;
     st_node[top] = root;
     st_t[top++] = t0;
     while (top > 0) {
@@ -47,7 +47,7 @@ __device__ Found first_leaf(const CutNode* nodes, uint32_t root, vec3 o, vec3 d,
         n = load_node(nodes, node);
         if (n.right == kCutLeafTag) {
             float ea = 0.0f, eb = 0.0f;
-            clip_dilated(n.lo, n.hi, o, d, id, dilation, ea, eb);
+            clip_dilated(n.centre, n.half, o, d, id, dilation, ea, eb);
             best = Found{int32_t(n.left), ea, eb};
             best_entry = te;
             continue;
@@ -61,7 +61,8 @@ __device__ Found first_leaf(const CutNode* nodes, uint32_t root, vec3 o, vec3 d,
             const uint32_t child = kids[k];
             if (child == kCutNone) continue;
             const LoadedNode c = load_node(nodes, child);
-            if (clip_dilated(c.lo, c.hi, o, d, id, dilation, t0, t1) && t1 > min_exit && t0 < best_entry) {
+            if (clip_dilated(c.centre, c.half, o, d, id, dilation, t0, t1) && t1 > min_exit &&
+                t0 < best_entry) {
                 kn[count] = child;
                 kt[count++] = t0;
             }
