@@ -1,14 +1,16 @@
 // Fused tensor-core MLP of the N-BVH network (shared/mlp.h) with GL_NV_cooperative_matrix: a workgroup
 // of NB_NEURAL_GROUP (64) invocations = 2 subgroups of 32 evaluates 64 queries; each subgroup owns 32
-// rows (queries) of the activation matrices. Features and activations stay in shared memory
-// (on chip) between layers; weights are read as 16x16 fp16 tiles straight from the storage buffer
+// rows (queries) of the activation matrices. The features are staged in shared memory; with NB_COOP_FAST
+// the activations of hidden layers stay in registers as fp16 matrices (each layer's output tiles are the
+// next layer's A operands), else they go back to shared memory in place between layers; weights are read as 16x16 fp16 tiles straight from the storage buffer
 // (38 KiB, L1/L2 resident), each B tile once per subgroup and layer, from a copy with every matrix
 // transposed and tiled (engine/render/neural_model_gpu.h transpose_mlp, shared/mlp.h
 // nb_coop_weight_slot) so each B = W^T tile is 512 contiguous bytes (4 cache lines, not 16).
 // Per layer: H_out(32 x 64) = relu(H_in(32 x K) * W^T(K x 64)), K = 96 or 64,
 // 16x16x16 tiles, accumulators fp32 (NB_COOP_ACC_BITS 32, rounding points of mlp.h R3/R4 with a
 // different summation order) or fp16 (16, for devices without fp32 accumulation).
-// Shared memory: 64x104 halves (in place for every layer) + 64x20 floats = 18 KiB (48 KiB on NVIDIA).
+// Shared memory: 64x104 halves (features; in place for every layer without NB_COOP_FAST) + 64x20 floats
+// = 18 KiB (48 KiB on NVIDIA).
 //
 // Only compiled into passes that are created on devices with VK_NV_cooperative_matrix, 16x16x16 fp16
 // shapes and subgroup size 32 (engine/render/neural_model_gpu.cpp checks). The including shader
@@ -53,6 +55,11 @@
 // gather of lib/neural_grid.glsl, NB_GATHER_LEVELS levels at a time (v17). The fp16-accumulator
 // kernel (coop16, for devices without fp32 accumulation) keeps the earlier looped form (0) and the
 // one-query-per-lane gather. Both read the tiled weights (MLP alone 1.77 -> 3.14 G/s, v17).
+// NB_COOP_FAST also keeps the hidden activations in registers (nb_mlp_forward_coopmat below): the
+// features' gathers and the MLP's shared-memory tiles share the SM's L1/shared-memory data path, so the
+// 32 KiB per subgroup and batch that the in-place layers moved through shared memory slowed the gathers
+// of the other subgroups (H200: MLP alone 3.06 -> 4.05 G/s, fused random queries 1.02 -> 1.14 G/s,
+// coherent 1.17 -> 1.30; 170 -> 183 registers; results/neural/README.md).
 #ifndef NB_COOP_FAST
 #define NB_COOP_FAST 0
 #endif
@@ -113,6 +120,80 @@ float nb_coop_x_read(uint row, uint f) {
         NB_COOP_SYNC();                                                                               \
     }
 
+#if NB_COOP_FAST
+// Layer 0 (K = 96, A tiles from the staged features in shared memory) into fp16 matrices kept in
+// registers (the same products and fp32 sums as the in-place form, so the same outputs): H[nt] = rows row0..+15, columns nt*16..+15; H[4 + nt] = rows row0+16..+31.
+#define NB_COOP_LAYER0_REGS(H)                                                                          \
+    {                                                                                                 \
+        NB_FCM(NB_COOP_ACC_BITS) acc[8];                                                              \
+        NB_UNROLL for (uint j = 0u; j < 8u; ++j) acc[j] = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));    \
+        NB_UNROLL for (uint kt = 0u; kt < NB_MLP_INPUTS / 16u; ++kt) {                                \
+            NB_FCM(16) a0;                                                                            \
+            NB_FCM(16) a1;                                                                            \
+            coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false);   \
+            coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false); \
+            NB_UNROLL for (uint nt = 0u; nt < 4u; ++nt) {                                             \
+                NB_FCM(16) b;                                                                         \
+                coopMatLoadNV(b, neural_mlp_tiles, (nb_mlp_layer_offset(0u) + nb_coop_weight_slot(NB_MLP_WIDTH, kt * 16u, nt * 16u)) / 8u, 2u, false); \
+                acc[nt] = coopMatMulAddNV(a0, b, acc[nt]);                                            \
+                acc[4u + nt] = coopMatMulAddNV(a1, b, acc[4u + nt]);                                  \
+            }                                                                                         \
+        }                                                                                             \
+        NB_UNROLL for (uint j = 0u; j < 8u; ++j) {                                                    \
+            NB_UNROLL for (int e = 0; e < acc[j].length(); ++e) acc[j][e] = max(acc[j][e], NB_ACC_T(0.0)); \
+            H[j] = NB_FCM(16)(acc[j]);                                                                \
+        }                                                                                             \
+    }
+
+// Hidden layer m >= 1 from and to registers: one output column tile at a time (two accumulators),
+// the inputs H read as A operands directly, no shared-memory round trip of the activations.
+#define NB_COOP_HIDDEN_REGS(H, M)                                                                       \
+    {                                                                                                 \
+        NB_FCM(16) o[8];                                                                              \
+        NB_UNROLL for (uint nt = 0u; nt < 4u; ++nt) {                                                 \
+            NB_FCM(NB_COOP_ACC_BITS) c0 = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));                    \
+            NB_FCM(NB_COOP_ACC_BITS) c1 = c0;                                                         \
+            NB_UNROLL for (uint kt = 0u; kt < 4u; ++kt) {                                             \
+                NB_FCM(16) b;                                                                         \
+                coopMatLoadNV(b, neural_mlp_tiles, (nb_mlp_layer_offset(M) + nb_coop_weight_slot(NB_MLP_WIDTH, kt * 16u, nt * 16u)) / 8u, 2u, false); \
+                c0 = coopMatMulAddNV(H[kt], b, c0);                                                   \
+                c1 = coopMatMulAddNV(H[4u + kt], b, c1);                                              \
+            }                                                                                         \
+            NB_UNROLL for (int e = 0; e < c0.length(); ++e) {                                         \
+                c0[e] = max(c0[e], NB_ACC_T(0.0));                                                    \
+                c1[e] = max(c1[e], NB_ACC_T(0.0));                                                    \
+            }                                                                                         \
+            o[nt] = NB_FCM(16)(c0);                                                                   \
+            o[4u + nt] = NB_FCM(16)(c1);                                                              \
+        }                                                                                             \
+        NB_UNROLL for (uint j = 0u; j < 8u; ++j) H[j] = o[j];                                         \
+    }
+
+void nb_mlp_forward_coopmat() {
+    uint row0 = (gl_LocalInvocationID.x / NB_COOP_ROWS) * NB_COOP_ROWS;
+    NB_FCM(16) h[8];
+    NB_COOP_LAYER0_REGS(h)
+    NB_COOP_HIDDEN_REGS(h, 1u)
+    NB_COOP_HIDDEN_REGS(h, 2u)
+    NB_COOP_HIDDEN_REGS(h, 3u)
+    // Output layer (16 x 64, rows 8..15 zero padding): fp32 pre-activation (R4).
+    NB_FCM(NB_COOP_ACC_BITS) acc0 = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));
+    NB_FCM(NB_COOP_ACC_BITS) acc1 = acc0;
+    NB_UNROLL for (uint kt = 0u; kt < NB_MLP_WIDTH / 16u; ++kt) {
+        NB_FCM(16) b;
+        coopMatLoadNV(b, neural_mlp_tiles,
+                      (nb_mlp_layer_offset(NB_MLP_HIDDEN_LAYERS) + nb_coop_weight_slot(NB_MLP_OUTPUTS_PADDED, kt * 16u, 0u)) / 8u,
+                      2u, false);
+        acc0 = coopMatMulAddNV(h[kt], b, acc0);
+        acc1 = coopMatMulAddNV(h[4u + kt], b, acc1);
+    }
+    NB_FCM(32) y0 = NB_FCM(32)(acc0);
+    NB_FCM(32) y1 = NB_FCM(32)(acc1);
+    coopMatStoreNV(y0, nb_sh_y, row0 * NB_COOP_Y_STRIDE, NB_COOP_Y_STRIDE, false);
+    coopMatStoreNV(y1, nb_sh_y, (row0 + 16u) * NB_COOP_Y_STRIDE, NB_COOP_Y_STRIDE, false);
+    NB_COOP_SYNC();
+}
+#else
 void nb_mlp_forward_coopmat() {
     uint row0 = (gl_LocalInvocationID.x / NB_COOP_ROWS) * NB_COOP_ROWS;
     NB_COOP_HIDDEN_LAYER(NB_MLP_INPUTS, neural_mlp_tiles, nb_mlp_layer_offset(0u), NB_MLP_WIDTH)
@@ -142,6 +223,8 @@ void nb_mlp_forward_coopmat() {
     }
     NB_COOP_SYNC();
 }
+
+#endif
 
 // Writes one query's 96 features (rounded to fp16, R1) into its row of nb_sh_x, level by level (no
 // per-point array stays live); zeros when !valid.
