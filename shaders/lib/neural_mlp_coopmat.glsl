@@ -93,61 +93,56 @@ float nb_coop_x_read(uint row, uint f) {
 
 #define NB_FCM(BITS) fcoopmatNV<BITS, gl_ScopeSubgroup, 16, 16>
 
-// One hidden layer for the 32 rows of this subgroup: X[:, 0:64] = half(relu(X[:, 0:K] * W_m^T)).
-#define NB_COOP_HIDDEN_LAYER(K, WBUF, WOFF, WOUTS)                                                                      \
-    {                                                                                                 \
-        NB_FCM(NB_COOP_ACC_BITS) acc[8];                                                              \
-        NB_UNROLL for (uint j = 0u; j < 8u; ++j) acc[j] = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));             \
-        NB_UNROLL for (uint kt = 0u; kt < (K) / 16u; ++kt) {                                          \
-            NB_FCM(16) a0;                                                                            \
-            NB_FCM(16) a1;                                                                            \
-            coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false);   \
-            coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false); \
-            NB_UNROLL for (uint nt = 0u; nt < 4u; ++nt) {                                             \
-                NB_FCM(16) b;                                                                         \
-                coopMatLoadNV(b, WBUF, ((WOFF) + nb_coop_weight_slot(WOUTS, kt * 16u, nt * 16u)) / 8u, 2u, false); \
-                acc[nt] = coopMatMulAddNV(a0, b, acc[nt]);                                            \
-                acc[4u + nt] = coopMatMulAddNV(a1, b, acc[4u + nt]);                                  \
-            }                                                                                         \
+// ACC[0..7] = X[:, 0:K] * W_m^T for the 32 rows of this subgroup, the A tiles loaded from nb_sh_x:
+// ACC[nt] = rows row0..+15, output columns nt*16..+15; ACC[4 + nt] = rows row0+16..+31.
+#define NB_COOP_ACC_FROM_SHARED(ACC, K, WOFF)                                                         \
+    NB_UNROLL for (uint j = 0u; j < 8u; ++j) ACC[j] = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));        \
+    NB_UNROLL for (uint kt = 0u; kt < (K) / 16u; ++kt) {                                              \
+        NB_FCM(16) a0;                                                                                \
+        NB_FCM(16) a1;                                                                                \
+        coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false);       \
+        coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false); \
+        NB_UNROLL for (uint nt = 0u; nt < 4u; ++nt) {                                                 \
+            NB_FCM(16) b;                                                                             \
+            coopMatLoadNV(b, neural_mlp_tiles, ((WOFF) + nb_coop_weight_slot(NB_MLP_WIDTH, kt * 16u, nt * 16u)) / 8u, 2u, false); \
+            ACC[nt] = coopMatMulAddNV(a0, b, ACC[nt]);                                                \
+            ACC[4u + nt] = coopMatMulAddNV(a1, b, ACC[4u + nt]);                                      \
         }                                                                                             \
-        NB_COOP_SYNC();                                                                               \
-        NB_UNROLL for (uint j = 0u; j < 8u; ++j) {                                                    \
-            NB_UNROLL for (int e = 0; e < acc[j].length(); ++e) acc[j][e] = max(acc[j][e], NB_ACC_T(0.0));      \
-            NB_FCM(16) o = NB_FCM(16)(acc[j]);                                                        \
-            uint r = row0 + (j >> 2u) * 16u;                                                          \
-            coopMatStoreNV(o, nb_sh_x, r * NB_COOP_STRIDE_V + (j & 3u) * 2u, NB_COOP_STRIDE_V, false); \
-        }                                                                                             \
-        NB_COOP_SYNC();                                                                               \
     }
 
+// The output layer's fp32 pre-activations (R4) of the subgroup's two row tiles into nb_sh_y.
+#define NB_COOP_STORE_OUTPUTS(ACC0, ACC1)                                                             \
+    {                                                                                                 \
+        NB_FCM(32) y0 = NB_FCM(32)(ACC0);                                                             \
+        NB_FCM(32) y1 = NB_FCM(32)(ACC1);                                                             \
+        coopMatStoreNV(y0, nb_sh_y, row0 * NB_COOP_Y_STRIDE, NB_COOP_Y_STRIDE, false);                \
+        coopMatStoreNV(y1, nb_sh_y, (row0 + 16u) * NB_COOP_Y_STRIDE, NB_COOP_Y_STRIDE, false);        \
+    }
+
+// B tile kt of the output layer (16 x 64, rows 8..15 zero padding).
+#define NB_COOP_LOAD_OUTPUT_B(B, KT)                                                                  \
+    coopMatLoadNV(B, neural_mlp_tiles,                                                                \
+                  (nb_mlp_layer_offset(NB_MLP_HIDDEN_LAYERS) + nb_coop_weight_slot(NB_MLP_OUTPUTS_PADDED, (KT) * 16u, 0u)) / 8u, \
+                  2u, false)
+
 #if NB_COOP_FAST
-// Layer 0 (K = 96, A tiles from the staged features in shared memory) into fp16 matrices kept in
-// registers (the same products and fp32 sums as the in-place form, so the same outputs): H[nt] = rows row0..+15, columns nt*16..+15; H[4 + nt] = rows row0+16..+31.
-#define NB_COOP_LAYER0_REGS(H)                                                                          \
+// The hidden activations stay in registers as fp16 matrices, H[nt] = rows row0..+15, columns
+// nt*16..+15 and H[4 + nt] = rows row0+16..+31: each layer's output tiles are the next layer's A
+// operands. The same products and fp32 sums, in the same order, as the in-place form below.
+
+// Layer 0 (K = 96, A tiles from the staged features) into H.
+#define NB_COOP_LAYER0_REGS(H)                                                                        \
     {                                                                                                 \
         NB_FCM(NB_COOP_ACC_BITS) acc[8];                                                              \
-        NB_UNROLL for (uint j = 0u; j < 8u; ++j) acc[j] = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));    \
-        NB_UNROLL for (uint kt = 0u; kt < NB_MLP_INPUTS / 16u; ++kt) {                                \
-            NB_FCM(16) a0;                                                                            \
-            NB_FCM(16) a1;                                                                            \
-            coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false);   \
-            coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false); \
-            NB_UNROLL for (uint nt = 0u; nt < 4u; ++nt) {                                             \
-                NB_FCM(16) b;                                                                         \
-                coopMatLoadNV(b, neural_mlp_tiles, (nb_mlp_layer_offset(0u) + nb_coop_weight_slot(NB_MLP_WIDTH, kt * 16u, nt * 16u)) / 8u, 2u, false); \
-                acc[nt] = coopMatMulAddNV(a0, b, acc[nt]);                                            \
-                acc[4u + nt] = coopMatMulAddNV(a1, b, acc[4u + nt]);                                  \
-            }                                                                                         \
-        }                                                                                             \
+        NB_COOP_ACC_FROM_SHARED(acc, NB_MLP_INPUTS, nb_mlp_layer_offset(0u))                          \
         NB_UNROLL for (uint j = 0u; j < 8u; ++j) {                                                    \
             NB_UNROLL for (int e = 0; e < acc[j].length(); ++e) acc[j][e] = max(acc[j][e], NB_ACC_T(0.0)); \
             H[j] = NB_FCM(16)(acc[j]);                                                                \
         }                                                                                             \
     }
 
-// Hidden layer m >= 1 from and to registers: one output column tile at a time (two accumulators),
-// the inputs H read as A operands directly, no shared-memory round trip of the activations.
-#define NB_COOP_HIDDEN_REGS(H, M)                                                                       \
+// Hidden layer m >= 1 from and to H, one output column tile at a time (two accumulators).
+#define NB_COOP_HIDDEN_REGS(H, M)                                                                     \
     {                                                                                                 \
         NB_FCM(16) o[8];                                                                              \
         NB_UNROLL for (uint nt = 0u; nt < 4u; ++nt) {                                                 \
@@ -176,54 +171,55 @@ void nb_mlp_forward_coopmat() {
     NB_COOP_HIDDEN_REGS(h, 1u)
     NB_COOP_HIDDEN_REGS(h, 2u)
     NB_COOP_HIDDEN_REGS(h, 3u)
-    // Output layer (16 x 64, rows 8..15 zero padding): fp32 pre-activation (R4).
     NB_FCM(NB_COOP_ACC_BITS) acc0 = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));
     NB_FCM(NB_COOP_ACC_BITS) acc1 = acc0;
     NB_UNROLL for (uint kt = 0u; kt < NB_MLP_WIDTH / 16u; ++kt) {
         NB_FCM(16) b;
-        coopMatLoadNV(b, neural_mlp_tiles,
-                      (nb_mlp_layer_offset(NB_MLP_HIDDEN_LAYERS) + nb_coop_weight_slot(NB_MLP_OUTPUTS_PADDED, kt * 16u, 0u)) / 8u,
-                      2u, false);
+        NB_COOP_LOAD_OUTPUT_B(b, kt);
         acc0 = coopMatMulAddNV(h[kt], b, acc0);
         acc1 = coopMatMulAddNV(h[4u + kt], b, acc1);
     }
-    NB_FCM(32) y0 = NB_FCM(32)(acc0);
-    NB_FCM(32) y1 = NB_FCM(32)(acc1);
-    coopMatStoreNV(y0, nb_sh_y, row0 * NB_COOP_Y_STRIDE, NB_COOP_Y_STRIDE, false);
-    coopMatStoreNV(y1, nb_sh_y, (row0 + 16u) * NB_COOP_Y_STRIDE, NB_COOP_Y_STRIDE, false);
+    NB_COOP_STORE_OUTPUTS(acc0, acc1)
     NB_COOP_SYNC();
 }
 #else
+// One hidden layer in place in nb_sh_x: X[:, 0:64] = half(relu(X[:, 0:K] * W_m^T)) (all of its input
+// tiles are loaded before a barrier, then the outputs stored).
+#define NB_COOP_HIDDEN_LAYER(K, WOFF)                                                                 \
+    {                                                                                                 \
+        NB_FCM(NB_COOP_ACC_BITS) acc[8];                                                              \
+        NB_COOP_ACC_FROM_SHARED(acc, K, WOFF)                                                         \
+        NB_COOP_SYNC();                                                                               \
+        NB_UNROLL for (uint j = 0u; j < 8u; ++j) {                                                    \
+            NB_UNROLL for (int e = 0; e < acc[j].length(); ++e) acc[j][e] = max(acc[j][e], NB_ACC_T(0.0)); \
+            NB_FCM(16) o = NB_FCM(16)(acc[j]);                                                        \
+            uint r = row0 + (j >> 2u) * 16u;                                                          \
+            coopMatStoreNV(o, nb_sh_x, r * NB_COOP_STRIDE_V + (j & 3u) * 2u, NB_COOP_STRIDE_V, false); \
+        }                                                                                             \
+        NB_COOP_SYNC();                                                                               \
+    }
+
 void nb_mlp_forward_coopmat() {
     uint row0 = (gl_LocalInvocationID.x / NB_COOP_ROWS) * NB_COOP_ROWS;
-    NB_COOP_HIDDEN_LAYER(NB_MLP_INPUTS, neural_mlp_tiles, nb_mlp_layer_offset(0u), NB_MLP_WIDTH)
-    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_tiles, nb_mlp_layer_offset(1u), NB_MLP_WIDTH)
-    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_tiles, nb_mlp_layer_offset(2u), NB_MLP_WIDTH)
-    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, neural_mlp_tiles, nb_mlp_layer_offset(3u), NB_MLP_WIDTH)
-    // Output layer (16 x 64, rows 8..15 zero padding): fp32 pre-activation (R4).
-    {
-        NB_FCM(NB_COOP_ACC_BITS) acc0 = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));
-        NB_FCM(NB_COOP_ACC_BITS) acc1 = acc0;
-        NB_UNROLL for (uint kt = 0u; kt < NB_MLP_WIDTH / 16u; ++kt) {
-            NB_FCM(16) b;
-            coopMatLoadNV(b, neural_mlp_tiles,
-                          (nb_mlp_layer_offset(NB_MLP_HIDDEN_LAYERS) + nb_coop_weight_slot(NB_MLP_OUTPUTS_PADDED, kt * 16u, 0u)) / 8u,
-                          2u, false);
-            NB_FCM(16) a0;
-            NB_FCM(16) a1;
-            coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false);
-            coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false);
-            acc0 = coopMatMulAddNV(a0, b, acc0);
-            acc1 = coopMatMulAddNV(a1, b, acc1);
-        }
-        NB_FCM(32) y0 = NB_FCM(32)(acc0);
-        NB_FCM(32) y1 = NB_FCM(32)(acc1);
-        coopMatStoreNV(y0, nb_sh_y, row0 * NB_COOP_Y_STRIDE, NB_COOP_Y_STRIDE, false);
-        coopMatStoreNV(y1, nb_sh_y, (row0 + 16u) * NB_COOP_Y_STRIDE, NB_COOP_Y_STRIDE, false);
+    NB_COOP_HIDDEN_LAYER(NB_MLP_INPUTS, nb_mlp_layer_offset(0u))
+    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, nb_mlp_layer_offset(1u))
+    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, nb_mlp_layer_offset(2u))
+    NB_COOP_HIDDEN_LAYER(NB_MLP_WIDTH, nb_mlp_layer_offset(3u))
+    NB_FCM(NB_COOP_ACC_BITS) acc0 = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));
+    NB_FCM(NB_COOP_ACC_BITS) acc1 = acc0;
+    NB_UNROLL for (uint kt = 0u; kt < NB_MLP_WIDTH / 16u; ++kt) {
+        NB_FCM(16) b;
+        NB_COOP_LOAD_OUTPUT_B(b, kt);
+        NB_FCM(16) a0;
+        NB_FCM(16) a1;
+        coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false);
+        coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false);
+        acc0 = coopMatMulAddNV(a0, b, acc0);
+        acc1 = coopMatMulAddNV(a1, b, acc1);
     }
+    NB_COOP_STORE_OUTPUTS(acc0, acc1)
     NB_COOP_SYNC();
 }
-
 #endif
 
 // Writes one query's 96 features (rounded to fp16, R1) into its row of nb_sh_x, level by level (no
