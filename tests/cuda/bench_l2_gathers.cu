@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <cstdio>
 
+#include "tests/cuda/bench_timing.cuh"
+
 namespace {
 
 constexpr uint32_t kThreads = 1u << 22, kLoads = 16u; // 64 M accesses per launch
@@ -44,26 +46,15 @@ template <int W> __global__ void k_gather(const uint4* table, uint32_t words, ui
 }
 
 template <int W> void measure(const char* table_name, const uint4* table, uint32_t words, uint32_t* sink) {
-    cudaEvent_t a, b;
-    cudaEventCreate(&a);
-    cudaEventCreate(&b);
     const uint32_t blocks = kThreads / 256u;
-    for (uint32_t s = 0; s < 3; ++s) k_gather<W><<<blocks, 256>>>(table, words, s, sink); // warm-up
-    constexpr int kReps = 20;
-    cudaEventRecord(a);
-    for (int r = 0; r < kReps; ++r) k_gather<W><<<blocks, 256>>>(table, words, 100u + uint32_t(r), sink);
-    cudaEventRecord(b);
-    cudaEventSynchronize(b);
-    float ms = 0.0f;
-    cudaEventElapsedTime(&ms, a, b);
-    const double per = double(ms) / kReps, accesses = double(kThreads) * kLoads;
+    const double per = nbvh::bench::mean_launch_ms(
+        [&](uint32_t seed) { k_gather<W><<<blocks, 256>>>(table, words, seed, sink); });
+    const double accesses = double(kThreads) * kLoads;
     std::printf(
         "%-22s %2d B: %.4f ms per %.0f M accesses: %.1f G accesses/s, %.0f GB/s requested; 96 per query: "
         "%.2f G queries/s (%s)\n",
         table_name, W, per, accesses / 1e6, accesses / (per * 1e6), accesses * W / (per * 1e6),
         accesses / (per * 1e6) / 96.0, cudaGetErrorString(cudaGetLastError()));
-    cudaEventDestroy(a);
-    cudaEventDestroy(b);
 }
 
 } // namespace

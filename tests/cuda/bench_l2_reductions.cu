@@ -12,6 +12,8 @@
 #include <cstdint>
 #include <cstdio>
 
+#include "tests/cuda/bench_timing.cuh"
+
 namespace {
 
 constexpr uint32_t kEntries = 1u << 21, kItems = (1u << 18) * 3u * 6u, kCorners = 8u;
@@ -57,23 +59,10 @@ template <Way W> __global__ void k_scatter(float* grad, uint32_t seed) {
 }
 
 template <Way W> void measure(const char* name, float* grad) {
-    cudaEvent_t a, b;
-    cudaEventCreate(&a);
-    cudaEventCreate(&b);
     const uint32_t blocks = (kItems + 255u) / 256u;
-    for (uint32_t s = 0; s < 3; ++s) k_scatter<W><<<blocks, 256>>>(grad, s); // warm-up
-    constexpr int kReps = 20;
-    cudaEventRecord(a);
-    for (int r = 0; r < kReps; ++r) k_scatter<W><<<blocks, 256>>>(grad, 100u + uint32_t(r));
-    cudaEventRecord(b);
-    cudaEventSynchronize(b);
-    float ms = 0.0f;
-    cudaEventElapsedTime(&ms, a, b);
-    const double per = double(ms) / kReps;
+    const double per = nbvh::bench::mean_launch_ms([&](uint32_t seed) { k_scatter<W><<<blocks, 256>>>(grad, seed); });
     std::printf("%-9s %.4f ms per %u items x %u corners: %.1f G reductions/s (%s)\n", name, per, kItems,
                 kCorners, double(kItems) * kCorners / (per * 1e6), cudaGetErrorString(cudaGetLastError()));
-    cudaEventDestroy(a);
-    cudaEventDestroy(b);
 }
 
 } // namespace
