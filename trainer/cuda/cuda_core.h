@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "engine/neural/shared/training_loss.h"
-#include "shaders/shared/bvh_node.h"
 #include "shaders/shared/hashgrid.h"
 #include "shaders/shared/neural_query.h"
 #include "shaders/shared/wide_bvh_node.h"
