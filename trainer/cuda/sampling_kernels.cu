@@ -143,50 +143,57 @@ constexpr uint32_t kFullWarp = 0xFFFFFFFFu;
 // that needs many redraws gets the lanes of the slots already done instead of leaving them idle (the
 // per-slot loop this replaces cost a warp its slowest slot's redraw count). A slot's sample is its
 // first kept attempt and only attempts up to it count as draws: the CPU loop's result, bit for bit.
+// The body is a grid-stride loop although the launch covers the batch (one pass): in that form nvcc 13
+// gives the kernel 48 registers instead of 68 (sm_90, no spills), 10 resident blocks per SM instead
+// of 7, and the walks' stack loads more warps to hide behind: sampling 0.518 -> 0.473 ms on the H200
+// (results/cuda_training.md). Forcing fewer registers (launch bounds of 12 or 16 blocks) spills and
+// loses; drawing ahead with 8 blocks per SM looping over the batch lost too (perf/dropped/README.md).
 constexpr uint32_t kSampleBlock = 128; // whole warps: k_sample's lanes cooperate with full-mask intrinsics
 static_assert(kSampleBlock % 32u == 0u, "k_sample needs whole warps");
 
 __global__ void k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint64_t seed, uint32_t step,
                          unsigned long long* draws_total, uint32_t* valid_total) {
     const uint32_t lane = threadIdx.x & 31u;
-    const uint32_t slot = blockIdx.x * blockDim.x + threadIdx.x;
-    const uint32_t warp_base = slot - lane;
-    bool open = slot < batch; // as the owner of `slot`
-    uint32_t next = 0;        // as the owner: attempts taken so far
     uint32_t drawn = 0, valid = 0;
-    for (;;) {
-        const uint32_t open_mask = __ballot_sync(kFullWarp, open);
-        if (open_mask == 0u) break;
-        const uint32_t n = uint32_t(__popc(open_mask));
-        // As an attempter: which slot, which attempt.
-        const uint32_t rank = lane % n;
-        const uint32_t owner = nth_set_bit(open_mask, rank);
-        const uint32_t attempt = __shfl_sync(kFullWarp, next, owner) + lane / n;
-        const bool active = attempt < kMaxSampleAttempts;
-        Attempt r{};
-        if (active) r = try_attempt(a, c, SampleSlot{seed, step, warp_base + owner}, attempt);
-        const bool success = active && r.kept;
-        const uint32_t wins = __ballot_sync(kFullWarp, success);
-        const uint32_t mine = wins & lanes_of_rank(rank, n);
-        const uint32_t first = mine ? uint32_t(__ffs(int(mine)) - 1) : 32u;
-        if (active && lane <= first) { // attempts up to the slot's first kept one count
-            drawn++;
-            if (r.cut == 0u && r.f.leaf >= 0) atomicAdd(&c.leaf_draws[r.f.leaf], 1u);
-        }
-        if (success && lane == first)
-            write_sample(b, warp_base + owner, r.o + r.d * r.f.t_entry, r.d, fmaxf(r.f.t_exit - r.f.t_entry, 0.0f),
-                         r.f.leaf, r.cut);
-        if (open) { // as the owner: done, or the attempts this round took
-            const uint32_t my_rank = uint32_t(__popc(open_mask & ((1u << lane) - 1u)));
-            const uint32_t lanes = lanes_of_rank(my_rank, n);
-            if (wins & lanes) {
-                open = false;
-                valid++;
-            } else {
-                next += uint32_t(__popc(lanes));
-                if (next >= kMaxSampleAttempts) { // starved: no reachable leaf
+    for (uint32_t base = blockIdx.x * blockDim.x; base < batch; base += gridDim.x * blockDim.x) {
+        const uint32_t slot = base + threadIdx.x;
+        const uint32_t warp_base = slot - lane;
+        bool open = slot < batch; // as the owner of `slot`
+        uint32_t next = 0;        // as the owner: attempts taken so far
+        for (;;) {
+            const uint32_t open_mask = __ballot_sync(kFullWarp, open);
+            if (open_mask == 0u) break;
+            const uint32_t n = uint32_t(__popc(open_mask));
+            // As an attempter: which slot, which attempt.
+            const uint32_t rank = lane % n;
+            const uint32_t owner = nth_set_bit(open_mask, rank);
+            const uint32_t attempt = __shfl_sync(kFullWarp, next, owner) + lane / n;
+            const bool active = attempt < kMaxSampleAttempts;
+            Attempt r{};
+            if (active) r = try_attempt(a, c, SampleSlot{seed, step, warp_base + owner}, attempt);
+            const bool success = active && r.kept;
+            const uint32_t wins = __ballot_sync(kFullWarp, success);
+            const uint32_t mine = wins & lanes_of_rank(rank, n);
+            const uint32_t first = mine ? uint32_t(__ffs(int(mine)) - 1) : 32u;
+            if (active && lane <= first) { // attempts up to the slot's first kept one count
+                drawn++;
+                if (r.cut == 0u && r.f.leaf >= 0) atomicAdd(&c.leaf_draws[r.f.leaf], 1u);
+            }
+            if (success && lane == first)
+                write_sample(b, warp_base + owner, r.o + r.d * r.f.t_entry, r.d,
+                             fmaxf(r.f.t_exit - r.f.t_entry, 0.0f), r.f.leaf, r.cut);
+            if (open) { // as the owner: done, or the attempts this round took
+                const uint32_t my_rank = uint32_t(__popc(open_mask & ((1u << lane) - 1u)));
+                const uint32_t lanes = lanes_of_rank(my_rank, n);
+                if (wins & lanes) {
                     open = false;
-                    write_sample(b, slot, vec3(0.0f), vec3(0.0f), 0.0f, -1, 0u);
+                    valid++;
+                } else {
+                    next += uint32_t(__popc(lanes));
+                    if (next >= kMaxSampleAttempts) { // starved: no reachable leaf
+                        open = false;
+                        write_sample(b, slot, vec3(0.0f), vec3(0.0f), 0.0f, -1, 0u);
+                    }
                 }
             }
         }
@@ -393,7 +400,11 @@ __device__ vec3 normal_mapped(const DevAsset& a, uint32_t p, float u, float v, v
     return nb_normal_map(n, t4, texel, nm.scale);
 }
 
-__global__ void k_ground_truth(DevAsset a, DevBatch b, uint64_t seed, uint32_t step) {
+// At most 64 registers (8 blocks of 128 per SM instead of 6 at the 80 the compiler picks; 16 bytes
+// spilled): the walk waits on its node loads, and 2 more warps per scheduler hide more of them
+// (H200: ground truth 0.257 -> 0.245 ms; 10 or 12 blocks spill 176 / 336 bytes and lose).
+__global__ void __launch_bounds__(128, 8)
+    k_ground_truth(DevAsset a, DevBatch b, uint64_t seed, uint32_t step) {
     const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= b.n) return;
     float tg[8] = {0, 0, 0, 0, 0, 0, 0, 0};
