@@ -12,6 +12,7 @@
 
 #include "tests/cuda/clip_box_kernels.h"
 #include "tests/cuda/cuda_test_support.h"
+#include "trainer/cuda/cut_tree.h"
 #include "trainer/training_rays.h"
 
 namespace nbvh {
@@ -74,6 +75,26 @@ std::vector<test::ClipCase> hard_cases() {
             v.push_back(make_case(glm::vec3(-5e3f), glm::vec3(5e3f), glm::vec3(-9e3f, 2.0f * k, 7.0f), d, dil));
         }
     }
+    // For the branch-free clip: the smallest normal direction components (1/d near its largest finite
+    // value), origins on the slab planes with either sign of d, boxes at the loader's 1e9 limit.
+    for (float dil : {1e-5f, 1.1e-4f}) {
+        for (float s : {1.17549435e-38f, -1.17549435e-38f, 2.5e-38f})
+            v.push_back(make_case(lo, hi, {0.2f, -5.0f, 0.1f}, {s, 1.0f, -s}, dil));
+        for (float sx : {1.0f, -1.0f})
+            for (float ox : {-1.0f, 1.0f}) {
+                v.push_back(
+                    make_case(lo, hi, {ox, 0.5f, 0.1f}, glm::normalize(glm::vec3(sx, 0.3f, -0.2f)), dil));
+                v.push_back(make_case(lo, hi, {ox * 1.00001f, 2.0f, 0.5f},
+                                      glm::normalize(glm::vec3(sx, -1.0f, -0.5f)), dil));
+            }
+        const glm::vec3 big(1e9f, -1e9f, 5e8f);
+        for (int k = 0; k < 4; ++k) {
+            const glm::vec3 d = glm::normalize(glm::vec3(1.0f - 0.5f * k, -0.3f, 0.2f * k + 0.1f));
+            v.push_back(make_case(big - 0.5f, big + 0.5f, big - d * 3.0f, d, dil));
+            v.push_back(
+                make_case(glm::vec3(-1e9f), glm::vec3(1e9f), glm::vec3(-1.4e9f, 3.0f * k, -7.0f), d, dil));
+        }
+    }
     // Random rays and boxes at unit scale (the sampler's distribution: origins in a 1.5x box, unit dirs).
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f), dl(1e-5f, 1.1e-4f);
@@ -91,7 +112,7 @@ TEST(CudaSamplerClip, MatchesTheCpuClipBitForBit) {
     std::vector<test::ClipCase> cases = hard_cases();
     const std::vector<test::ClipCase> input = cases;
     ASSERT_EQ(test::clip_on_device(cases), "");
-    size_t hits = 0, misses = 0;
+    size_t hits = 0, misses = 0, regular = 0, never = 0;
     for (size_t i = 0; i < cases.size(); ++i) {
         const test::ClipCase& in = input[i];
         Aabb box;
@@ -101,6 +122,22 @@ TEST(CudaSamplerClip, MatchesTheCpuClipBitForBit) {
         const bool hit = clip_line_to_box(glm::vec3(in.origin[0], in.origin[1], in.origin[2]),
                                           glm::vec3(in.dir[0], in.dir[1], in.dir[2]), dilate_box(box, in.dilation), t0, t1);
         ASSERT_EQ(cases[i].hit != 0u, hit) << "case " << i;
+        float c[3], h[3];
+        cuda::box_centre_half(in.box, in.box + 3, c, h);
+        const cuda::CutBox kind = cuda::classify_cut_box(c, h);
+        if (kind == cuda::CutBox::never_crossed) {
+            EXPECT_FALSE(hit) << "case " << i << ": the cut tree leaves this box out";
+            never++;
+        }
+        if (cases[i].regular) { // the branch-free clip: the same hit, entry and exit
+            regular++;
+            EXPECT_EQ(kind, cuda::CutBox::regular) << "case " << i;
+            ASSERT_EQ(cases[i].hit_regular != 0u, hit) << "case " << i << " (clip_regular)";
+            if (hit) {
+                EXPECT_TRUE(same_bits(cases[i].t_entry_regular, t0)) << "case " << i << " (clip_regular)";
+                EXPECT_TRUE(same_bits(cases[i].t_exit_regular, t1)) << "case " << i << " (clip_regular)";
+            }
+        }
         if (!hit) {
             misses++;
             continue;
@@ -109,9 +146,13 @@ TEST(CudaSamplerClip, MatchesTheCpuClipBitForBit) {
         EXPECT_TRUE(same_bits(cases[i].t_entry, t0)) << "case " << i << ": " << cases[i].t_entry << " vs " << t0;
         EXPECT_TRUE(same_bits(cases[i].t_exit, t1)) << "case " << i << ": " << cases[i].t_exit << " vs " << t1;
     }
-    std::printf("%zu cases: %zu hits, %zu misses, all equal to the CPU's bits\n", cases.size(), hits, misses);
+    std::printf("%zu cases: %zu hits, %zu misses, all equal to the CPU's bits; %zu through clip_regular, "
+                "%zu boxes the cut tree leaves out\n",
+                cases.size(), hits, misses, regular, never);
     EXPECT_GT(hits, 3000u);
     EXPECT_GT(misses, 3000u);
+    EXPECT_GT(regular, 20000u);
+    EXPECT_GE(never, 9u);
 }
 
 } // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 
 #include "tests/cuda/cuda_test_support.h"
@@ -143,6 +144,35 @@ TEST(CutTree, OneChildNodesAndBaseLeavesBelowNoCutLeaf) {
         EXPECT_EQ(nodes[i].centre[0], 0.5f); // box [-i, i + 1]
         EXPECT_EQ(nodes[i].half[0], float(i) + 0.5f);
     }
+}
+
+TEST(CutTree, BoxesNoRayCrossesAreLeftOutWithTheirSubtrees) {
+    // The CPU's clip rejects an empty or non-finite box whatever the ray, so its subtree is never walked:
+    // the tree leaves it out (the GPU's branch-free clip_regular needs every kept box regular).
+    // Base: 0 -> (1, 2); 1 (NaN bound) -> (3, none); 2 (empty) and 3 are leaves, 3 in the cut.
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::vector<float> boxes{-1, -1, -1, 1, 1, 1, -1, nan, -1, 1, 1, 1, 1, 0, 0, -1, 1, 1, 0, 0, 0, 1, 1, 1};
+    const std::vector<uint32_t> children{1, 2, 3, kCutNone, kCutNone, kCutNone, kCutNone, kCutNone};
+    const std::vector<int32_t> leaf_of{-1, -1, -1, 0};
+    std::vector<CutNode> nodes;
+    std::vector<uint32_t> roots;
+    cuda::append_cut_tree(boxes, children, leaf_of, {0}, nodes, roots);
+    ASSERT_EQ(nodes.size(), 1u);
+    EXPECT_EQ(roots, (std::vector<uint32_t>{0u}));
+    EXPECT_EQ(nodes[0].left, kCutNone);
+    EXPECT_EQ(nodes[0].right, kCutNone);
+    // A root no ray crosses: the part has no root (the sampler finds no leaf there).
+    nodes.clear();
+    roots.clear();
+    cuda::append_cut_tree(boxes, children, leaf_of, {2, 0}, nodes, roots);
+    EXPECT_EQ(roots, (std::vector<uint32_t>{kCutNone, 0u}));
+    // A finite box beyond 1e37 (the loader stops at 1e9): refused, not clipped with overflowing bounds.
+    boxes[3] = 3e37f;
+    nodes.clear();
+    roots.clear();
+    EXPECT_THROW(cuda::append_cut_tree(boxes, children, leaf_of, {0}, nodes, roots), std::invalid_argument);
+    const float c[3] = {0.0f, 0.0f, 0.0f}, h[3] = {1.0f, 0.0f, 1e30f};
+    EXPECT_EQ(cuda::classify_cut_box(c, h), cuda::CutBox::regular);
 }
 
 TEST(CutTree, RejectsInconsistentInput) {

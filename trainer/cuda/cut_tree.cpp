@@ -29,11 +29,19 @@ void append_cut_tree(const std::vector<float>& boxes, const std::vector<uint32_t
             const Entry e = stack.back();
             stack.pop_back();
             if (nodes.size() >= limit) throw std::invalid_argument("cut tree: the base BVH is not a tree");
+            CutNode n{};
+            box_centre_half(&boxes[6 * size_t(e.node)], &boxes[6 * size_t(e.node) + 3], n.centre, n.half);
+            const CutBox kind = classify_cut_box(n.centre, n.half);
+            if (kind == CutBox::out_of_range)
+                throw std::invalid_argument("cut tree: the box of base node " + std::to_string(e.node) +
+                                            " reaches beyond 1e37");
+            if (kind == CutBox::never_crossed) { // no ray enters it: left out with its subtree
+                if (e.side < 0) roots.back() = kCutNone;
+                continue;
+            }
             const uint32_t me = uint32_t(nodes.size());
             if (e.side == 0) nodes[e.parent].left = me;
             if (e.side == 1) nodes[e.parent].right = me;
-            CutNode n{};
-            box_centre_half(&boxes[6 * size_t(e.node)], &boxes[6 * size_t(e.node) + 3], n.centre, n.half);
             n.left = n.right = kCutNone;
             const int32_t slot = leaf_of_base_node[e.node];
             if (slot >= 0) {

@@ -6,6 +6,7 @@
 // CPU's first_leaf_of_cut (trainer/training_rays.cpp), so both draw the same rays.
 // Host code (g++ and nvcc): plain arrays only.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -33,6 +34,25 @@ inline void box_centre_half(const float lo[3], const float hi[3], float centre[3
     }
 }
 static_assert(sizeof(CutNode) == 32, "CutNode is two 16-byte loads");
+
+// What the sampler's clip (clip_box.cuh) does with a box, as centre and half extent: a regular box
+// (finite, not empty, |centre| + 2 |half| <= 1e37 on every axis, so its bounds stay finite at any
+// dilation below 1e-3) takes the branch-free clip_regular; an empty box or one with a non-finite bound
+// is never crossed (the CPU's clip_line_to_box rejects it whatever the ray), so the cut tree leaves it
+// and its subtree out; anything else (finite, beyond 1e37: the scene loader stops at 1e9) is refused.
+enum class CutBox { regular, never_crossed, out_of_range };
+inline CutBox classify_cut_box(const float centre[3], const float half[3]) {
+    bool never = false, beyond = false;
+    for (int k = 0; k < 3; ++k) {
+        const float c = centre[k], h = half[k];
+        // NaN or infinite: lo or hi of the dilated box is NaN or infinite; h < 0: lo > hi.
+        if (!std::isfinite(c) || !std::isfinite(h) || h < 0.0f)
+            never = true;
+        else if (!(std::fabs(c) + 2.0f * h <= 1e37f))
+            beyond = true;
+    }
+    return never ? CutBox::never_crossed : beyond ? CutBox::out_of_range : CutBox::regular;
+}
 
 // Appends the compact tree of one cut to `nodes` and one root per part to `roots` (compact index, or
 // kCutNone for an empty base BVH). `boxes`: 6 floats per base node; `children`: 2 per base node

@@ -24,19 +24,33 @@ __device__ inline LoadedNode load_node(const CutNode* nodes, uint32_t i) {
     return LoadedNode{{a.x, a.y, a.z}, {a.w, __uint_as_float(b.x), __uint_as_float(b.y)}, b.z, b.w};
 }
 
+// A cut node's dilated box clipped: clip_regular where the ray allows it (every box of the tree is
+// regular, cut_tree.h), else the general clip_dilated. The same bits either way (clip_box.cuh).
+template <bool kRegularRay>
+__device__ inline bool clip_node(const LoadedNode& n, vec3 o, vec3 d, const InvDir& id, const SlabRay& sr,
+                                 float dilation, float& t0, float& t1) {
+    if constexpr (kRegularRay)
+        return clip_regular(n.centre, n.half, sr, t0, t1);
+    else
+        return clip_dilated(n.centre, n.half, o, d, id, dilation, t0, t1);
+}
+
 // first_leaf_of_cut (trainer/training_rays.cpp): nearest-first descent from a part's root, stopping at
 // cut leaves, on the cut's compact tree. Same nodes in the same order as the CPU's walk of the base BVH.
-__device__ Found first_leaf(const CutNode* nodes, uint32_t root, vec3 o, vec3 d, float dilation, float min_exit) {
+template <bool kRegularRay>
+__device__ Found first_leaf(const CutNode* nodes, uint32_t root, vec3 o, vec3 d, float dilation,
+                            float min_exit) {
     Found best{-1, 0.0f, 0.0f};
-    if (root == kCutNone) return best; // empty base BVH
+    if (root == kCutNone) return best; // empty base BVH, or a root box no ray crosses
     const InvDir id = inv_dir(d);
+    const SlabRay sr = slab_ray(o, d, id, dilation);
     float best_entry = NB_INF;
     uint32_t st_node[NB_BVH_MAX_DEPTH * 2 + 2];
     float st_t[NB_BVH_MAX_DEPTH * 2 + 2];
     int top = 0;
     float t0, t1;
     LoadedNode n = load_node(nodes, root);
-    if (!clip_dilated(n.centre, n.half, o, d, id, dilation, t0, t1) || t1 <= min_exit) return best;
+    if (!clip_node<kRegularRay>(n, o, d, id, sr, dilation, t0, t1) || t1 <= min_exit) return best;
     st_node[top] = root;
     st_t[top++] = t0;
     while (top > 0) {
@@ -47,7 +61,7 @@ __device__ Found first_leaf(const CutNode* nodes, uint32_t root, vec3 o, vec3 d,
         n = load_node(nodes, node);
         if (n.right == kCutLeafTag) {
             float ea = 0.0f, eb = 0.0f;
-            clip_dilated(n.centre, n.half, o, d, id, dilation, ea, eb);
+            clip_node<kRegularRay>(n, o, d, id, sr, dilation, ea, eb);
             best = Found{int32_t(n.left), ea, eb};
             best_entry = te;
             continue;
@@ -61,7 +75,7 @@ __device__ Found first_leaf(const CutNode* nodes, uint32_t root, vec3 o, vec3 d,
             const uint32_t child = kids[k];
             if (child == kCutNone) continue;
             const LoadedNode c = load_node(nodes, child);
-            if (clip_dilated(c.centre, c.half, o, d, id, dilation, t0, t1) && t1 > min_exit &&
+            if (clip_node<kRegularRay>(c, o, d, id, sr, dilation, t0, t1) && t1 > min_exit &&
                 t0 < best_entry) {
                 kn[count] = child;
                 kt[count++] = t0;
@@ -106,7 +120,9 @@ __device__ Attempt try_attempt(const DevAsset& a, const DevCuts& c, const Sample
     const float sin_theta = sqrtf(fmaxf(0.0f, 1.0f - cos_theta * cos_theta));
     r.d = vec3(sin_theta * cosf(phi), sin_theta * sinf(phi), cos_theta);
     const float dilation = 1e-5f + 1e-4f * rng.next_float();
-    r.f = first_leaf(c.nodes, c.roots[r.cut * a.parts + pi], r.o, r.d, dilation, a.min_exit);
+    const uint32_t root = c.roots[r.cut * a.parts + pi];
+    r.f = slab_ray_regular(r.d) ? first_leaf<true>(c.nodes, root, r.o, r.d, dilation, a.min_exit)
+                                : first_leaf<false>(c.nodes, root, r.o, r.d, dilation, a.min_exit);
     r.kept = r.f.leaf >= 0;
     if (r.kept && r.cut == 0) {
         const float keep = c.keep[r.f.leaf];
@@ -144,10 +160,11 @@ constexpr uint32_t kFullWarp = 0xFFFFFFFFu;
 // per-slot loop this replaces cost a warp its slowest slot's redraw count). A slot's sample is its
 // first kept attempt and only attempts up to it count as draws: the CPU loop's result, bit for bit.
 // The body is a grid-stride loop although the launch covers the batch (one pass): in that form nvcc 13
-// gives the kernel 48 registers instead of 68 (sm_90, no spills), 10 resident blocks per SM instead
-// of 7, and the walks' stack loads more warps to hide behind: sampling 0.518 -> 0.473 ms on the H200
-// (results/cuda_training.md). Forcing fewer registers (launch bounds of 12 or 16 blocks) spills and
-// loses; drawing ahead with 8 blocks per SM looping over the batch lost too (perf/dropped/README.md).
+// gave the kernel 48 registers instead of 68 (sm_90, no spills; 54 since the walk's clip_regular path),
+// 10 resident blocks per SM instead of 7 (9 now), and the walks' stack loads more warps to hide behind:
+// sampling 0.518 -> 0.473 ms on the H200 (results/cuda_training.md). Forcing fewer registers (launch
+// bounds of 10, 12 or 16 blocks) spills and loses; drawing ahead with 8 blocks per SM looping over the
+// batch lost too.
 constexpr uint32_t kSampleBlock = 128; // whole warps: k_sample's lanes cooperate with full-mask intrinsics
 static_assert(kSampleBlock % 32u == 0u, "k_sample needs whole warps");
 
