@@ -76,8 +76,12 @@ std::vector<test::ClipCase> hard_cases() {
         }
     }
     // For the branch-free clip: the smallest normal direction components (1/d near its largest finite
-    // value), origins on the slab planes with either sign of d, boxes at the loader's 1e9 limit.
+    // value), origins on the box's faces and just outside them with either sign of d, boxes at the
+    // loader's 1e9 limit, and a flat box at -0 seen from +0 along -x (slab distances +0 and -0: the one
+    // place clip_regular's entry and exit differ from the CPU's in sign, both 0).
     for (float dil : {1e-5f, 1.1e-4f}) {
+        v.push_back(make_case({-0.0f, -1.0f, -1.0f}, {-0.0f, 1.0f, 1.0f}, {0.0f, 0.2f, -0.3f},
+                              glm::normalize(glm::vec3(-1.0f, 0.1f, 0.2f)), dil));
         for (float s : {1.17549435e-38f, -1.17549435e-38f, 2.5e-38f})
             v.push_back(make_case(lo, hi, {0.2f, -5.0f, 0.1f}, {s, 1.0f, -s}, dil));
         for (float sx : {1.0f, -1.0f})
@@ -112,7 +116,7 @@ TEST(CudaSamplerClip, MatchesTheCpuClipBitForBit) {
     std::vector<test::ClipCase> cases = hard_cases();
     const std::vector<test::ClipCase> input = cases;
     ASSERT_EQ(test::clip_on_device(cases), "");
-    size_t hits = 0, misses = 0, regular = 0, never = 0;
+    size_t hits = 0, misses = 0, regular = 0, never = 0, exit_zero = 0;
     for (size_t i = 0; i < cases.size(); ++i) {
         const test::ClipCase& in = input[i];
         Aabb box;
@@ -131,11 +135,14 @@ TEST(CudaSamplerClip, MatchesTheCpuClipBitForBit) {
         }
         if (cases[i].regular) { // the branch-free clip: the same hit, entry and exit
             regular++;
-            EXPECT_EQ(kind, cuda::CutBox::regular) << "case " << i;
             ASSERT_EQ(cases[i].hit_regular != 0u, hit) << "case " << i << " (clip_regular)";
-            if (hit) {
+            if (hit && t1 != 0.0f) {
                 EXPECT_TRUE(same_bits(cases[i].t_entry_regular, t0)) << "case " << i << " (clip_regular)";
                 EXPECT_TRUE(same_bits(cases[i].t_exit_regular, t1)) << "case " << i << " (clip_regular)";
+            } else if (hit) { // t_exit = +-0: the walk rejects it either way (clip_box.cuh: +-0 ties)
+                EXPECT_EQ(cases[i].t_exit_regular, 0.0f) << "case " << i << " (clip_regular)";
+                EXPECT_EQ(cases[i].t_entry_regular, t0) << "case " << i << " (clip_regular)";
+                exit_zero++;
             }
         }
         if (!hit) {
@@ -146,13 +153,14 @@ TEST(CudaSamplerClip, MatchesTheCpuClipBitForBit) {
         EXPECT_TRUE(same_bits(cases[i].t_entry, t0)) << "case " << i << ": " << cases[i].t_entry << " vs " << t0;
         EXPECT_TRUE(same_bits(cases[i].t_exit, t1)) << "case " << i << ": " << cases[i].t_exit << " vs " << t1;
     }
-    std::printf("%zu cases: %zu hits, %zu misses, all equal to the CPU's bits; %zu through clip_regular, "
-                "%zu boxes the cut tree leaves out\n",
-                cases.size(), hits, misses, regular, never);
+    std::printf("%zu cases: %zu hits, %zu misses, all equal to the CPU's bits; %zu through clip_regular (%zu "
+                "hits with t_exit = +-0 compared by value), %zu boxes the cut tree leaves out\n",
+                cases.size(), hits, misses, regular, exit_zero, never);
     EXPECT_GT(hits, 3000u);
     EXPECT_GT(misses, 3000u);
     EXPECT_GT(regular, 20000u);
     EXPECT_GE(never, 9u);
+    EXPECT_GE(exit_zero, 2u);
 }
 
 } // namespace

@@ -171,6 +171,16 @@ TEST(CutTree, BoxesNoRayCrossesAreLeftOutWithTheirSubtrees) {
     nodes.clear();
     roots.clear();
     EXPECT_THROW(cuda::append_cut_tree(boxes, children, leaf_of, {0}, nodes, roots), std::invalid_argument);
+    // The left child dropped, the right one kept: it is linked from the parent's right field.
+    const std::vector<float> two{-1, -1, -1, 1, 1, 1, -1, nan, -1, 1, 1, 1, 0, 0, 0, 1, 1, 1};
+    nodes.clear();
+    roots.clear();
+    cuda::append_cut_tree(two, {1, 2, kCutNone, kCutNone, kCutNone, kCutNone}, {-1, -1, 0}, {0}, nodes,
+                          roots);
+    ASSERT_EQ(nodes.size(), 2u);
+    EXPECT_EQ(nodes[0].left, kCutNone);
+    EXPECT_EQ(nodes[0].right, 1u);
+    EXPECT_EQ(nodes[1].right, kCutLeafTag);
     const float c[3] = {0.0f, 0.0f, 0.0f}, h[3] = {1.0f, 0.0f, 1e30f};
     EXPECT_EQ(cuda::classify_cut_box(c, h), cuda::CutBox::regular);
 }
