@@ -49,18 +49,18 @@ __device__ inline bool clip_dilated(const float centre[3], const float half_exte
 }
 
 // The same clip for the common case, without its branches: a box the cut tree keeps (cut_tree.h
-// cut_box_regular: finite, not empty, |centre| + 2 |half| <= 1e37, so every bound of every dilation is
-// finite) and a ray whose direction components are all normal floats (slab_ray_regular: 1/d is finite
-// and no axis is parallel). Then clip_dilated never takes its early returns or its parallel-axis branch,
-// and its swap is decided by the sign of d alone: for d > 0, lo <= hi gives (lo - o) / d <= (hi - o) / d
-// (rounding is monotonic), for d < 0 the reverse. So each axis computes its near bound c - s h (1 + dil)
-// and far bound c + s h (1 + dil) with s = sign(d) folded into `gs` (a product by -1 and x - (-y) are
-// exact), the same floats as clip_dilated's after its swap: the same hit and the same t_entry and t_exit
-// to the bit (tests/cuda/clip_box_test.cpp), with one exception: where an axis's two slab distances are
-// zeros of opposite sign, clip_dilated keeps them unswapped and this clip reverses them, so a hit there
-// has entry and exit (+0, -0) against (-0, +0). Such a hit has t_exit = 0, which the first-leaf walk
-// rejects (t_exit <= min_exit, min_exit > 0: training_asset.cpp), so the walk's results are the same.
-// About half the instructions per box (the first-leaf walk clips two child boxes per node).
+// classify_cut_box, regular: finite, not empty, |centre| + 2 |half| <= 1e37, so every bound of every dilation
+// is finite) and a ray whose direction components are all normal floats (slab_ray_regular: 1/d is finite and
+// no axis is parallel). Then clip_dilated never takes its early returns or its parallel-axis branch, and its
+// swap is decided by the sign of d alone: for d > 0, lo <= hi gives (lo - o) / d <= (hi - o) / d (rounding is
+// monotonic), for d < 0 the reverse. So each axis computes its near bound c - s h (1 + dil) and far bound c +
+// s h (1 + dil) with s = sign(d) folded into `gs` (a product by -1 and x - (-y) are exact), the same floats
+// as clip_dilated's after its swap: the same hit and the same t_entry and t_exit to the bit
+// (tests/cuda/clip_box_test.cpp), with one exception: where an axis's two slab distances are zeros of
+// opposite sign, clip_dilated keeps them unswapped and this clip reverses them, so a hit there has entry and
+// exit (+0, -0) against (-0, +0). Such a hit has t_exit = 0, which the first-leaf walk rejects (t_exit <=
+// min_exit, min_exit > 0: training_asset.cpp), so the walk's results are the same. About half the
+// instructions per box (the first-leaf walk clips two child boxes per node).
 struct SlabRay {
     float o[3], inv[3], gs[3];
 };

@@ -25,7 +25,8 @@ __device__ inline LoadedNode load_node(const CutNode* nodes, uint32_t i) {
 }
 
 // A cut node's dilated box clipped: clip_regular where the ray allows it (every box of the tree is
-// regular, cut_tree.h), else the general clip_dilated. The same bits either way (clip_box.cuh).
+// regular, cut_tree.h), else the general clip_dilated. The walk finds the same leaf, entry and exit
+// either way (clip_box.cuh).
 template <bool kRegularRay>
 __device__ inline bool clip_node(const LoadedNode& n, vec3 o, vec3 d, const InvDir& id, const SlabRay& sr,
                                  float dilation, float& t0, float& t1) {
@@ -168,8 +169,9 @@ constexpr uint32_t kFullWarp = 0xFFFFFFFFu;
 // per-slot loop this replaces cost a warp its slowest slot's redraw count). A slot's sample is its
 // first kept attempt and only attempts up to it count as draws: the CPU loop's result, bit for bit.
 // The body is a grid-stride loop although the launch covers the batch (one pass): in that form nvcc 13
-// gave the kernel 48 registers instead of 68 (sm_90, no spills; 54 since the walk's clip_regular path),
-// 10 resident blocks per SM instead of 7 (9 now), and the walks' stack loads more warps to hide behind:
+// gave the kernel 48 registers instead of 68 (sm_90, no spills; 48 still with clip_regular and the
+// nearer child in registers), 10 resident blocks per SM instead of 7, and the walks' stack loads more
+// warps to hide behind:
 // sampling 0.518 -> 0.473 ms on the H200 (results/cuda_training.md). Forcing fewer registers (launch
 // bounds of 10, 12 or 16 blocks) spills and loses; drawing ahead with 8 blocks per SM looping over the
 // batch lost too.
