@@ -55,8 +55,10 @@ inline CutBox classify_cut_box(const float centre[3], const float half[3]) {
 }
 
 // Appends the compact tree of one cut to `nodes` and one root per part to `roots` (compact index, or
-// kCutNone for an empty base BVH). `boxes`: 6 floats per base node; `children`: 2 per base node
-// (kCutNone for none); `leaf_of_base_node`: the cut's slot per base node or -1.
+// kCutNone for an empty base BVH or a root box no ray crosses), leaving out the boxes no ray crosses
+// with their subtrees (classify_cut_box; throws std::invalid_argument for one out of range). `boxes`: 6
+// floats per base node; `children`: 2 per base node (kCutNone for none); `leaf_of_base_node`: the cut's slot
+// per base node or -1.
 void append_cut_tree(const std::vector<float>& boxes, const std::vector<uint32_t>& children,
                      const std::vector<int32_t>& leaf_of_base_node, const std::vector<uint32_t>& part_roots,
                      std::vector<CutNode>& nodes, std::vector<uint32_t>& roots);
