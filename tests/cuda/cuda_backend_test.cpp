@@ -2,7 +2,7 @@
 // matches the CPU tracer, the step's loss and gradients match the CPU reference network run on the
 // GPU's samples within fp16 bounds (deterministic mode), runs are reproducible, a short training run
 // follows the CPU loss curve, hard assets train without NaN, and a huge learning rate is caught by the
-// non-finite guard. Every test skips without a usable CUDA GPU.
+// non-finite guard, as is an overflowing loss scale. Every test skips without a usable CUDA GPU.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -337,6 +337,44 @@ TEST(CudaBackend, HugeLearningRateIsCaughtByTheGuard) {
         if (st.skipped) skipped++;
     }
     EXPECT_GE(skipped, 1u); // the first step blows the fp16 weights up; later steps are refused
+    neural::NetworkWeights w;
+    b->read_weights(w);
+    for (float v : w.mlp) ASSERT_TRUE(std::isfinite(v));
+    for (float v : w.grid) ASSERT_TRUE(std::isfinite(v));
+}
+
+// A loss scale of 65536 overflows the fp16 backward at the first steps (|dL/dz| x 65536 > 65504): the
+// guard skips those steps and halves the scale until the gradients are finite; no non-finite value
+// reaches the weights. In the fast mode the grid gradients are guarded by the grid backward kernels'
+// check of dL/dfeatures (no pass over the summed gradients, cuda_core.cu step).
+TEST(CudaBackend, OverflowingLossScaleIsHalvedByTheGuard) {
+    REQUIRE_GPU();
+    const Scene scene = test::scene_of(test::height_field(16, 0.2f, 1.0f, glm::vec3(0.0f)));
+    const TrainingAsset asset = make_training_asset(scene, 0);
+    TrainingCut cut = cut_at_depth(asset, 4);
+    CudaBackendOptions opt;
+    opt.loss_scale = 65536.0f;
+    auto b = make_cuda_backend_ex(asset, NeuralConfig{.log2_hash_size = 12}, neural::AdamConfig{}, opt, 3);
+    uint32_t skipped = 0, trained = 0;
+    for (uint32_t s = 0; s < 24; ++s) {
+        StepParams p;
+        p.step = s;
+        p.batch_size = 4096;
+        p.seed = 3;
+        p.cuts = {&cut};
+        p.cut_version = 1;
+        const StepStats st = b->step(p);
+        if (st.skipped) {
+            skipped++;
+            EXPECT_NE(st.skip_reason.find("non-finite gradient"), std::string::npos) << st.skip_reason;
+        } else {
+            trained++;
+            EXPECT_TRUE(std::isfinite(st.loss.total));
+        }
+    }
+    EXPECT_GE(skipped, 1u);
+    EXPECT_GE(trained, 1u);
+    EXPECT_LT(b->loss_scale(), 65536.0f);
     neural::NetworkWeights w;
     b->read_weights(w);
     for (float v : w.mlp) ASSERT_TRUE(std::isfinite(v));

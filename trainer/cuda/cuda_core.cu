@@ -83,17 +83,13 @@ __global__ void k_reduce_mlp(const float* slices, int blocks, float* grad, uint3
     if (!isfinite(s)) atomicOr(flag, NB_GUARD_GRADIENT);
 }
 
-// Grid gradient: converts the deterministic fixed-point sums, and checks finiteness either way.
+// Grid gradient of the deterministic mode: converts the fixed-point sums and checks them (the fast mode's
+// float sums are guarded by the grid backward kernels, see step()).
 __global__ void k_check_grid(float* grad, const unsigned long long* fx, uint32_t n, uint32_t* flag) {
     const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= n) return;
-    float g;
-    if (fx) {
-        g = float(double((long long)fx[i]) * (1.0 / double(NB_CUDA_FIXED_SCALE)));
-        grad[i] = g;
-    } else {
-        g = grad[i];
-    }
+    const float g = float(double((long long)fx[i]) * (1.0 / double(NB_CUDA_FIXED_SCALE)));
+    grad[i] = g;
     if (!isfinite(g)) atomicOr(flag, NB_GUARD_GRADIENT);
 }
 
@@ -186,8 +182,14 @@ public:
         da_.min_exit = a.min_exit;
 
         NBVH_CHECK_SIZE(c.levels.size() == NB_GRID_MAX_LEVELS && c.mlp.size() == NB_MLP_WEIGHT_COUNT);
-        for (uint32_t l = 0; l < NB_GRID_MAX_LEVELS; ++l) net_.levels[l] = c.levels[l];
+        for (uint32_t l = 0; l < NB_GRID_MAX_LEVELS; ++l) {
+            net_.levels[l] = c.levels[l];
+            // k_encode reads entry pairs (2e, 2e + 1) as one 16-byte word: even offsets and sizes keep
+            // every pair inside its level's table (level tables are multiples of 8 entries, hashgrid.h).
+            NBVH_CHECK_SIZE(c.levels[l].offset % 2u == 0u && c.levels[l].size % 2u == 0u);
+        }
         grid_n_ = uint32_t(c.grid.size());
+        NBVH_CHECK_SIZE(grid_n_ % 8u == 0u); // whole entry pairs (4 values each)
         grid_w_.upload(c.grid);
         mlp_w_.upload(c.mlp);
         for (auto* b : {&grid_m_, &grid_v_}) { b->alloc(grid_n_); b->zero_async(grid_n_, stream_); }
@@ -297,8 +299,13 @@ public:
         partials_.alloc(size_t(sblocks) * 6);
         k_stats<<<sblocks, kStatsThreads, 0, s>>>(batch, leaf_samples_.p, leaf_loss_fx_.p, partials_.p);
         k_reduce_mlp<<<(NB_MLP_WEIGHT_COUNT + 255) / 256, 256, 0, s>>>(slices_.p, blocks, mlp_grad_.p, flag);
-        k_check_grid<<<(grid_n_ + 255) / 256, 256, 0, s>>>(grid_grad_.p, cfg_.deterministic ? grid_grad_fx_.p : nullptr,
-                                                             grid_n_, flag);
+        // The deterministic sums are converted (and checked) here. The fast mode's float sums need no pass
+        // of their own: both grid backward kernels raise the guard on a non-finite dL/dfeature, and finite
+        // ones cannot overflow a sum: each is a 64-term fp32 sum of fp16 x fp16 products (k_mlp's wmma,
+        // |x| <= 64 x 65504^2 = 2.7e11) and an entry takes at most 8 weighted (w <= 1) adds per point of the
+        // batch (|sum| <= 24 n x 2.7e11: below FLT_MAX for any n below 5e25). H200: 16 us a step.
+        if (cfg_.deterministic)
+            k_check_grid<<<(grid_n_ + 255) / 256, 256, 0, s>>>(grid_grad_.p, grid_grad_fx_.p, grid_n_, flag);
         const GpuAdamRule mlp_rule{in.learning_rate, cfg_.beta1, cfg_.beta2, cfg_.epsilon, cfg_.l2_reg, 0u};
         const GpuAdamRule grid_rule{in.learning_rate, cfg_.beta1, cfg_.beta2, cfg_.epsilon, cfg_.non_matrix_l2_reg,
                                     cfg_.skip_zero_grad_non_matrix ? 1u : 0u};
