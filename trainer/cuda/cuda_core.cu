@@ -43,6 +43,10 @@ struct DevBuf {
 };
 
 constexpr int kStatsThreads = 256;
+// Copies of the per-leaf counters that k_stats's blocks spread their atomics over (block b adds to copy
+// b % kLeafCopies), folded by k_fold_leaf_stats: a leaf hit by thousands of samples took as many atomics
+// on one address.
+constexpr uint32_t kLeafCopies = 8;
 
 __global__ void k_to_half(const float* src, __half* dst, uint32_t n) {
     const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
@@ -50,9 +54,13 @@ __global__ void k_to_half(const float* src, __half* dst, uint32_t n) {
 }
 
 // Per-leaf statistics (cuts[0]) and per-block partial sums of the loss terms (fixed reduction order).
-__global__ void k_stats(DevBatch b, uint32_t* leaf_samples, unsigned long long* leaf_loss_fx, double* partials) {
+__global__ void k_stats(DevBatch b, uint32_t leaves, uint32_t* leaf_samples, unsigned long long* leaf_loss_fx,
+                        double* partials) {
     __shared__ double red[6][kStatsThreads];
     const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+    const size_t copy = size_t(blockIdx.x % kLeafCopies) * leaves;
+    leaf_samples += copy;
+    leaf_loss_fx += copy;
     double v[6] = {0, 0, 0, 0, 0, 0};
     if (i < b.n && b.leaf[i] >= 0) {
         for (int q = 0; q < 5; ++q) v[q] = b.loss[5 * size_t(i) + q];
@@ -71,6 +79,20 @@ __global__ void k_stats(DevBatch b, uint32_t* leaf_samples, unsigned long long* 
     }
     if (threadIdx.x == 0)
         for (int q = 0; q < 6; ++q) partials[blockIdx.x * 6 + q] = red[q][0];
+}
+
+// Copy 0 of the per-leaf counters += copies 1.. (integer sums: the same totals in any order).
+__global__ void k_fold_leaf_stats(uint32_t leaves, uint32_t* leaf_samples, unsigned long long* leaf_loss_fx) {
+    const uint32_t l = blockIdx.x * blockDim.x + threadIdx.x;
+    if (l >= leaves) return;
+    uint32_t n = 0;
+    unsigned long long fx = 0;
+    for (uint32_t k = 0; k < kLeafCopies; ++k) {
+        n += leaf_samples[size_t(k) * leaves + l];
+        fx += leaf_loss_fx[size_t(k) * leaves + l];
+    }
+    leaf_samples[l] = n;
+    leaf_loss_fx[l] = fx;
 }
 
 // MLP gradient = sum of the per-block slices in block order (deterministic), checked for finiteness.
@@ -235,8 +257,8 @@ public:
         cut_roots_.upload(roots);
         cut_count_ = uint32_t(cuts.size());
         leaves_ = cuts[0].leaves;
-        leaf_samples_.alloc(leaves_);
-        leaf_loss_fx_.alloc(leaves_);
+        leaf_samples_.alloc(size_t(leaves_) * kLeafCopies);
+        leaf_loss_fx_.alloc(size_t(leaves_) * kLeafCopies);
     }
 
     void step(const CoreStepIn& in, CoreStepOut& out) override {
@@ -268,8 +290,8 @@ public:
         uint32_t* valid = slot.valid();
         uint32_t* flag = flag_.p;
         flag_.zero_async(1, s);
-        leaf_samples_.zero_async(leaves_, s);
-        leaf_loss_fx_.zero_async(leaves_, s);
+        leaf_samples_.zero_async(size_t(leaves_) * kLeafCopies, s);
+        leaf_loss_fx_.zero_async(size_t(leaves_) * kLeafCopies, s);
         if (cfg_.deterministic) grid_grad_fx_.zero_async(grid_n_, s);
         else grid_grad_.zero_async(grid_n_, s);
         const int blocks = mlp_blocks_for(n);
@@ -297,7 +319,9 @@ public:
         record(5);
         const int sblocks = int((n + kStatsThreads - 1) / kStatsThreads);
         partials_.alloc(size_t(sblocks) * 6);
-        k_stats<<<sblocks, kStatsThreads, 0, s>>>(batch, leaf_samples_.p, leaf_loss_fx_.p, partials_.p);
+        k_stats<<<sblocks, kStatsThreads, 0, s>>>(batch, leaves_, leaf_samples_.p, leaf_loss_fx_.p,
+                                                  partials_.p);
+        k_fold_leaf_stats<<<(leaves_ + 255) / 256, 256, 0, s>>>(leaves_, leaf_samples_.p, leaf_loss_fx_.p);
         k_reduce_mlp<<<(NB_MLP_WEIGHT_COUNT + 255) / 256, 256, 0, s>>>(slices_.p, blocks, mlp_grad_.p, flag);
         // The deterministic sums are converted (and checked) here. The fast mode's float sums need no pass
         // of their own: both grid backward kernels raise the guard on a non-finite dL/dfeature, and finite
