@@ -381,6 +381,45 @@ TEST(CudaBackend, OverflowingLossScaleIsHalvedByTheGuard) {
     for (float v : w.grid) ASSERT_TRUE(std::isfinite(v));
 }
 
+// The fast mode sums the fine levels' grid gradients in fp16 (as tiny-cuda-nn): a batch concentrated on
+// one small quad at a large loss scale overflows those sums although every dL/dfeature is finite. The
+// guard must see it (the fp16 sums are checked before Adam): steps skipped, the scale halved, finite
+// weights.
+TEST(CudaBackend, OverflowingFp16GridGradientsAreGuarded) {
+    REQUIRE_GPU();
+    Mesh quad;
+    test::add_quad(quad, {0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f},
+                   {0, 0, 1});
+    const Scene scene = test::scene_of(std::move(quad));
+    const TrainingAsset asset = make_training_asset(scene, 0);
+    TrainingCut cut = cut_at_depth(asset, 0);
+    CudaBackendOptions opt;
+    opt.loss_scale = 16384.0f;
+    auto b = make_cuda_backend_ex(asset, NeuralConfig{.log2_hash_size = 14}, neural::AdamConfig{}, opt, 5);
+    uint32_t skipped = 0;
+    for (uint32_t s = 0; s < 6; ++s) {
+        StepParams p;
+        p.step = s;
+        p.batch_size = 65536;
+        p.seed = 5;
+        p.cuts = {&cut};
+        p.cut_version = 1;
+        const StepStats st = b->step(p);
+        if (st.skipped) {
+            skipped++;
+            EXPECT_NE(st.skip_reason.find("non-finite"), std::string::npos) << st.skip_reason;
+        }
+    }
+    std::printf("fp16 grid gradients at loss scale 16384: %u of 6 steps skipped, scale now %.0f\n", skipped,
+                b->loss_scale());
+    EXPECT_GE(skipped, 1u);
+    EXPECT_LT(b->loss_scale(), 16384.0f);
+    neural::NetworkWeights w;
+    b->read_weights(w);
+    for (float v : w.mlp) ASSERT_TRUE(std::isfinite(v));
+    for (float v : w.grid) ASSERT_TRUE(std::isfinite(v));
+}
+
 } // namespace
 // Several assets, one textured (base-colour texture with a KHR_texture_transform): the CUDA sampler
 // picks the part and searches its subtree as the CPU does, and its ground truth samples the texture

@@ -115,16 +115,25 @@ __global__ void k_check_grid(float* grad, const unsigned long long* fx, uint32_t
     if (!isfinite(g)) atomicOr(flag, NB_GUARD_GRADIENT);
 }
 
+// The fast mode's fp16 grid gradient (fine levels): fp16 sums can overflow, so they are checked.
+__global__ void k_check_half(const __half* grad, uint32_t first, uint32_t n, uint32_t* flag) {
+    const uint32_t i = first + blockIdx.x * blockDim.x + threadIdx.x;
+    if (i < n && !isfinite(__half2float(grad[i]))) atomicOr(flag, NB_GUARD_GRADIENT);
+}
+
 // tcnn Adam: nb_adam_update of engine/neural/shared/adam_update.h, the CPU's update (per-parameter step
 // counters; sparse skip of zero grid grads) on the batch-mean gradient (summed gradient / (loss scale x
 // trained samples)), then the fp16 copy. Does nothing when the guard flag is set or no sample was trained.
-__global__ void k_adam(float* w, float* m, float* v, uint32_t* t, __half* wh, const float* grad, uint32_t n,
-                       GpuAdamRule r, float scale_inv, const uint32_t* flag, const uint32_t* valid) {
+// The gradient of parameter i is grad[i] below `split`, grad_h[i] (fp16) from it on.
+__global__ void k_adam(float* w, float* m, float* v, uint32_t* t, __half* wh, const float* grad,
+                       const __half* grad_h, uint32_t split, uint32_t n, GpuAdamRule r, float scale_inv,
+                       const uint32_t* flag, const uint32_t* valid) {
     const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= n || *flag != 0u || *valid == 0u) return;
     float wi = w[i], mi = m[i], vi = v[i];
     uint32_t ti = t[i];
-    if (!nb_adam_update(wi, mi, vi, ti, grad[i] * (scale_inv / float(*valid)), r, nullptr, nullptr, 0u)) return;
+    const float g = i < split ? grad[i] : __half2float(grad_h[i]);
+    if (!nb_adam_update(wi, mi, vi, ti, g * (scale_inv / float(*valid)), r, nullptr, nullptr, 0u)) return;
     m[i] = mi;
     v[i] = vi;
     t[i] = ti;
@@ -229,6 +238,9 @@ public:
         net_.grid_h = grid_h_.p;
         net_.mlp_h = mlp_h_.p;
         net_.grid_grad = grid_grad_.p;
+        split_ = coarse_split(net_, c.deterministic);
+        if (!c.deterministic) grid_grad_h_.alloc(grid_n_);
+        net_.grid_grad_h = c.deterministic ? nullptr : grid_grad_h_.p;
         net_.grid_grad_fx = c.deterministic ? grid_grad_fx_.p : nullptr;
         net_.grid_values = grid_n_;
         flag_.alloc(1);
@@ -292,8 +304,12 @@ public:
         flag_.zero_async(1, s);
         leaf_samples_.zero_async(size_t(leaves_) * kLeafCopies, s);
         leaf_loss_fx_.zero_async(size_t(leaves_) * kLeafCopies, s);
-        if (cfg_.deterministic) grid_grad_fx_.zero_async(grid_n_, s);
-        else grid_grad_.zero_async(grid_n_, s);
+        if (cfg_.deterministic) {
+            grid_grad_fx_.zero_async(grid_n_, s);
+        } else {
+            grid_grad_.zero_async(split_.values, s);
+            grid_grad_h_.zero_async(grid_n_, s);
+        }
         const int blocks = mlp_blocks_for(n);
         slices_.alloc(size_t(blocks) * NB_MLP_WEIGHT_COUNT);
         slices_.zero_async(size_t(blocks) * NB_MLP_WEIGHT_COUNT, s);
@@ -323,21 +339,26 @@ public:
                                                   partials_.p);
         k_fold_leaf_stats<<<(leaves_ + 255) / 256, 256, 0, s>>>(leaves_, leaf_samples_.p, leaf_loss_fx_.p);
         k_reduce_mlp<<<(NB_MLP_WEIGHT_COUNT + 255) / 256, 256, 0, s>>>(slices_.p, blocks, mlp_grad_.p, flag);
-        // The deterministic sums are converted (and checked) here. The fast mode's float sums need no pass
-        // of their own: both grid backward kernels raise the guard on a non-finite dL/dfeature, and finite
-        // ones cannot overflow a sum: each is a 64-term fp32 sum of fp16 x fp16 products (k_mlp's wmma,
-        // |x| <= 64 x 65504^2 = 2.7e11) and an entry takes at most 8 weighted (w <= 1) adds per point of the
-        // batch (|sum| <= 24 n x 2.7e11: below FLT_MAX for any n below 5e25). H200: 16 us a step.
+        // The deterministic sums are converted (and checked) here. In the fast mode the coarse levels' fp32
+        // sums need no pass: both grid backward kernels raise the guard on a non-finite dL/dfeature, and
+        // finite ones cannot overflow an fp32 sum (each is a 64-term fp32 sum of fp16 x fp16 products,
+        // k_mlp's wmma, |x| <= 64 x 65504^2 = 2.7e11, and an entry takes at most 24 weighted (w <= 1) adds
+        // per sample: below FLT_MAX for any batch below 5e25); the fine levels' fp16 sums can overflow and
+        // are checked (half the bytes of the fp32 pass it replaced).
         if (cfg_.deterministic)
             k_check_grid<<<(grid_n_ + 255) / 256, 256, 0, s>>>(grid_grad_.p, grid_grad_fx_.p, grid_n_, flag);
+        else if (grid_n_ > split_.values)
+            k_check_half<<<(grid_n_ - split_.values + 255) / 256, 256, 0, s>>>(grid_grad_h_.p, split_.values,
+                                                                               grid_n_, flag);
         const GpuAdamRule mlp_rule{in.learning_rate, cfg_.beta1, cfg_.beta2, cfg_.epsilon, cfg_.l2_reg, 0u};
         const GpuAdamRule grid_rule{in.learning_rate, cfg_.beta1, cfg_.beta2, cfg_.epsilon, cfg_.non_matrix_l2_reg,
                                     cfg_.skip_zero_grad_non_matrix ? 1u : 0u};
-        k_adam<<<(NB_MLP_WEIGHT_COUNT + 255) / 256, 256, 0, s>>>(mlp_w_.p, mlp_m_.p, mlp_v_.p, mlp_t_.p, mlp_h_.p,
-                                                                  mlp_grad_.p, NB_MLP_WEIGHT_COUNT, mlp_rule,
-                                                                  1.0f / scale_, flag, valid);
+        k_adam<<<(NB_MLP_WEIGHT_COUNT + 255) / 256, 256, 0, s>>>(
+            mlp_w_.p, mlp_m_.p, mlp_v_.p, mlp_t_.p, mlp_h_.p, mlp_grad_.p, nullptr, NB_MLP_WEIGHT_COUNT,
+            NB_MLP_WEIGHT_COUNT, mlp_rule, 1.0f / scale_, flag, valid);
         k_adam<<<(grid_n_ + 255) / 256, 256, 0, s>>>(grid_w_.p, grid_m_.p, grid_v_.p, grid_t_.p, grid_h_.p,
-                                                      grid_grad_.p, grid_n_, grid_rule, 1.0f / scale_, flag, valid);
+                                                     grid_grad_.p, grid_grad_h_.p, grid_split(), grid_n_,
+                                                     grid_rule, 1.0f / scale_, flag, valid);
         NBVH_CUDA_CHECK(cudaGetLastError());
         record(6);
 
@@ -424,6 +445,12 @@ public:
         grid_grad.resize(grid_n_);
         NBVH_CUDA_CHECK(cudaMemcpy(mlp_grad.data(), mlp_grad_.p, mlp_grad.size() * 4, cudaMemcpyDeviceToHost));
         NBVH_CUDA_CHECK(cudaMemcpy(grid_grad.data(), grid_grad_.p, grid_grad.size() * 4, cudaMemcpyDeviceToHost));
+        if (grid_split() < grid_n_) { // the fast mode's fine levels: fp16
+            std::vector<__half> h(grid_n_ - grid_split());
+            NBVH_CUDA_CHECK(
+                cudaMemcpy(h.data(), grid_grad_h_.p + grid_split(), h.size() * 2, cudaMemcpyDeviceToHost));
+            for (size_t k = 0; k < h.size(); ++k) grid_grad[grid_split() + k] = __half2float(h[k]);
+        }
         const float inv = last_valid_ ? 1.0f / (last_scale_ * float(last_valid_)) : 0.0f;
         for (float& g : mlp_grad) g *= inv;
         for (float& g : grid_grad) g *= inv;
@@ -513,6 +540,10 @@ private:
     DevBuf<uint32_t> grid_t_, mlp_t_, leaf_samples_, flag_;
     DevBuf<__half> grid_h_, mlp_h_, b_feat_;
     DevBuf<unsigned long long> grid_grad_fx_, leaf_loss_fx_;
+    DevBuf<__half> grid_grad_h_; // the fast mode's fine-level gradient (fp16 vector reductions)
+    CoarseSplit split_;          // the fast mode's coarse levels (fp32 gradient below split_.values)
+    // Parameters below this index take the fp32 gradient (all in the deterministic mode).
+    uint32_t grid_split() const { return cfg_.deterministic ? grid_n_ : split_.values; }
     DevBuf<double> partials_;
     DevBuf<float> b_dfeat_, b_loss_; // features (b_feat_ above), dL/dfeature and losses: network part only
 };

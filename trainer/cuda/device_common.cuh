@@ -76,10 +76,19 @@ struct DevNetwork {
     GpuHashLevel levels[NB_GRID_MAX_LEVELS];
     const __half* grid_h = nullptr;
     const __half* mlp_h = nullptr;
-    float* grid_grad = nullptr;              // fast mode: float atomics
+    float* grid_grad = nullptr;    // fast mode: the coarse levels' values (fp32, flushed from shared memory)
+    __half* grid_grad_h = nullptr; // fast mode: the fine levels' values (fp16 vector reductions)
     unsigned long long* grid_grad_fx = nullptr; // deterministic mode: fixed point (two's complement)
     uint32_t grid_values = 0;
 };
+
+// Coarse levels of the fast mode's grid backward: the leading levels whose values fit the shared-memory
+// accumulator (k_grid_backward_coarse); none in the deterministic mode. `values`: their value count, where
+// the fine levels' fp16 gradient starts.
+struct CoarseSplit {
+    uint32_t levels = 0, values = 0;
+};
+CoarseSplit coarse_split(const DevNetwork& net, bool deterministic);
 
 // Fixed-point scale of the deterministic grid-gradient accumulation (values are loss-scaled).
 #define NB_CUDA_FIXED_SCALE 16777216.0f

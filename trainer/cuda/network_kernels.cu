@@ -182,9 +182,36 @@ __global__ void k_grid_backward_coarse(DevNetwork net, DevBatch b, uint32_t coar
     }
 }
 
+// fp16 pair (x in the low half) of two floats, round to nearest, as bits.
+__device__ inline uint32_t h2_bits(float x, float y) {
+    const __half2 h = __floats2half2_rn(x, y);
+    return *reinterpret_cast<const uint32_t*>(&h);
+}
+// Vector reductions of fp16 pairs in global memory (sm_90: red.global.add.noftz.v{2,4}.f16x2; no flush
+// to zero). Earlier architectures add the pairs with half2 atomics.
+__device__ inline void red_v2_f16x2(__half* dst, uint32_t a, uint32_t b) {
+#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900
+    asm volatile("red.global.add.noftz.v2.f16x2 [%0], {%1, %2};" ::"l"(dst), "r"(a), "r"(b) : "memory");
+#else
+    atomicAdd(reinterpret_cast<__half2*>(dst), *reinterpret_cast<const __half2*>(&a));
+    atomicAdd(reinterpret_cast<__half2*>(dst) + 1, *reinterpret_cast<const __half2*>(&b));
+#endif
+}
+__device__ inline void red_v4_f16x2(__half* dst, uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
+#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900
+    asm volatile("red.global.add.noftz.v4.f16x2 [%0], {%1, %2, %3, %4};" ::"l"(dst), "r"(a), "r"(b), "r"(c),
+                 "r"(d)
+                 : "memory");
+#else
+    red_v2_f16x2(dst, a, b);
+    red_v2_f16x2(dst + 4, c, d);
+#endif
+}
+
 // Grid backward: one thread per (sample, point, level >= first_level), 8 corners x 4 features. Levels below
 // `first_level` were done by k_grid_backward_coarse (threads are mapped to the remaining levels only, so no
 // warp lane idles on them).
+// 40 registers (6 blocks of 256 per SM; held to 32, it spilled and ran 1.5 % slower, H200).
 __global__ void k_grid_backward(DevNetwork net, DevBatch b, int deterministic, uint32_t first_level, uint32_t* flag) {
     const uint32_t tid = blockIdx.x * blockDim.x + threadIdx.x;
     const uint32_t levels = NB_GRID_MAX_LEVELS - first_level, per = NB_SEGMENT_POINTS * levels;
@@ -200,26 +227,39 @@ __global__ void k_grid_backward(DevNetwork net, DevBatch b, int deterministic, u
     uvec3 cell;
     vec3 frac;
     nb_grid_position(lv, p, cell, frac);
-    for (uint32_t c = 0; c < NB_GRID_CORNERS; ++c) {
-        const float w = nb_grid_corner_weight(frac, c);
-        const uint32_t e = nb_grid_corner_entry(lv, cell, c);
-        if (deterministic) {
+    if (deterministic) {
+        for (uint32_t c = 0; c < NB_GRID_CORNERS; ++c) {
+            const float w = nb_grid_corner_weight(frac, c);
+            const uint32_t e = nb_grid_corner_entry(lv, cell, c);
             // Integer addition is associative: the sum does not depend on the atomics' order.
             unsigned long long* dst = net.grid_grad_fx + size_t(e) * 4;
             atomicAdd(dst + 0, (unsigned long long)llrintf(w * df.x * NB_CUDA_FIXED_SCALE));
             atomicAdd(dst + 1, (unsigned long long)llrintf(w * df.y * NB_CUDA_FIXED_SCALE));
             atomicAdd(dst + 2, (unsigned long long)llrintf(w * df.z * NB_CUDA_FIXED_SCALE));
             atomicAdd(dst + 3, (unsigned long long)llrintf(w * df.w * NB_CUDA_FIXED_SCALE));
+        }
+        return;
+    }
+    // Fast mode: fp16 vector reductions, as tiny-cuda-nn accumulates its grid gradients (notes tiny-cuda-nn
+    // §B; it issues two half2 atomics per corner). Corners x and x + 1 whose entries share a 16-byte-aligned
+    // pair (entries differing only in bit 0, as in k_encode) take one 16-byte reduction for both; the
+    // others one 8-byte reduction each. The L2 serves these at a rate of requests (results/cuda_training.md
+    // bench_l2_reductions): fewer requests than one float4 per corner.
+    for (uint32_t c = 0; c < NB_GRID_CORNERS; c += 2) {
+        const uint32_t e0 = nb_grid_corner_entry(lv, cell, c), e1 = nb_grid_corner_entry(lv, cell, c + 1);
+        const float w0 = nb_grid_corner_weight(frac, c), w1 = nb_grid_corner_weight(frac, c + 1);
+        const uint32_t a0 = h2_bits(w0 * df.x, w0 * df.y), b0 = h2_bits(w0 * df.z, w0 * df.w);
+        const uint32_t a1 = h2_bits(w1 * df.x, w1 * df.y), b1 = h2_bits(w1 * df.z, w1 * df.w);
+        if ((e0 ^ e1) == 1u) {
+            const bool odd = (e0 & 1u) != 0u; // the pair's first entry is e1
+            __half* dst = net.grid_grad_h + size_t(e0 & ~1u) * 4;
+            if (odd)
+                red_v4_f16x2(dst, a1, b1, a0, b0);
+            else
+                red_v4_f16x2(dst, a0, b0, a1, b1);
         } else {
-            float* dst = net.grid_grad + size_t(e) * 4;
-#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900
-            atomicAdd(reinterpret_cast<float4*>(dst), make_float4(w * df.x, w * df.y, w * df.z, w * df.w));
-#else
-            atomicAdd(dst + 0, w * df.x);
-            atomicAdd(dst + 1, w * df.y);
-            atomicAdd(dst + 2, w * df.z);
-            atomicAdd(dst + 3, w * df.w);
-#endif
+            red_v2_f16x2(net.grid_grad_h + size_t(e0) * 4, a0, b0);
+            red_v2_f16x2(net.grid_grad_h + size_t(e1) * 4, a1, b1);
         }
     }
 }
@@ -485,15 +525,21 @@ void launch_encode(const DevNetwork& net, const DevBatch& b, cudaStream_t s) {
     NBVH_CUDA_CHECK(cudaGetLastError());
 }
 
+CoarseSplit coarse_split(const DevNetwork& net, bool deterministic) {
+    // The leading levels (offset 0..) whose values fit the shared-memory accumulator.
+    CoarseSplit c;
+    while (!deterministic && c.levels < NB_GRID_MAX_LEVELS &&
+           (net.levels[c.levels].offset + net.levels[c.levels].size) * 4u * 4u <= kCoarseSmemBytes) {
+        c.values = (net.levels[c.levels].offset + net.levels[c.levels].size) * 4u;
+        c.levels++;
+    }
+    return c;
+}
+
 void launch_grid_backward(const DevNetwork& net, const DevBatch& b, bool deterministic, uint32_t* flag,
                           cudaStream_t s) {
-    // Coarse levels: the leading levels (offset 0..) whose values fit the shared-memory accumulator.
-    uint32_t coarse = 0, values = 0;
-    while (!deterministic && coarse < NB_GRID_MAX_LEVELS &&
-           (net.levels[coarse].offset + net.levels[coarse].size) * 4u * 4u <= kCoarseSmemBytes) {
-        values = (net.levels[coarse].offset + net.levels[coarse].size) * 4u;
-        coarse++;
-    }
+    const CoarseSplit split = coarse_split(net, deterministic);
+    const uint32_t coarse = split.levels, values = split.values;
     if (coarse > 0) {
         static bool attr = false;
         if (!attr) {
