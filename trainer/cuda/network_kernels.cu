@@ -100,6 +100,8 @@ __global__ void __launch_bounds__(256, 8) k_encode(DevNetwork net, DevBatch b) {
 // Grid backward of the coarse levels (fast mode): their few entries receive thousands of adds per step,
 // which serialise in L2 as global atomics. Each block accumulates its share of the samples in shared
 // memory and flushes one global add per touched value.
+// Which levels are coarse: those whose values would fit this many bytes as fp32 (levels 0-1 of the paper
+// configuration; the fp16 accumulator uses half of it).
 constexpr uint32_t kCoarseSmemBytes = 96 * 1024;
 // The coarse-level backward of one (sample, level): each of the segment's points adds w_c * dL/dfeatures
 // to the 8 corners of its cell in the block's shared accumulator. Points in the same cell (a ray
@@ -108,11 +110,15 @@ constexpr uint32_t kCoarseSmemBytes = 96 * 1024;
 // reassociation. Non-finite gradients raise the guard. Not used on the fine levels (k_grid_backward,
 // one thread per point): there the points rarely share a cell and the merged form measured 1 % slower
 // (H200, results/cuda_training.md).
-// acc_s is feature-major (feature f of entry e at f * entries + e): with the 4 features of an entry in
-// consecutive words, the lanes' random entries fell on 8 bank groups (ncu on the H200: 44 % of the
-// kernel's shared wavefronts were conflict replays).
-__device__ void coarse_backward_sample_level(const GpuHashLevel& lv, const DevBatch& b, uint32_t i, uint32_t l,
-                                             uint32_t* flag, float* acc_s, uint32_t entries) {
+// The accumulator holds fp16 pairs, pair-major (features 0-1 of entry e at e, features 2-3 at entries +
+// e): two half2 shared atomics per corner instead of four float ones, each block's partial sums rounded
+// to fp16 (a block adds a few dozen terms per entry; the flush adds the blocks' partials in fp32 and
+// raises the guard on one that overflowed). H200: grid backward 0.423 -> 0.399 ms, the gradient against
+// the CPU reference 2.700e-3 -> 2.708e-3 (results/cuda_training.md). With the 4 features of an entry in
+// consecutive words the lanes' random entries fell on 8 bank groups (ncu: 44 % of the kernel's shared
+// wavefronts were conflict replays), hence the pair-major layout.
+__device__ void coarse_backward_sample_level(const GpuHashLevel& lv, const DevBatch& b, uint32_t i,
+                                             uint32_t l, uint32_t* flag, __half2* acc_h, uint32_t entries) {
     uvec3 cell[NB_SEGMENT_POINTS];
     vec3 frac[NB_SEGMENT_POINTS];
     float4 df[NB_SEGMENT_POINTS];
@@ -143,19 +149,21 @@ __device__ void coarse_backward_sample_level(const GpuHashLevel& lv, const DevBa
                 v.z += w * df[j].z;
                 v.w += w * df[j].w;
             }
-            float* dst = acc_s + nb_grid_corner_entry(lv, cell[k], c); // coarse levels start at entry 0
-            atomicAdd(dst, v.x);
-            atomicAdd(dst + entries, v.y);
-            atomicAdd(dst + 2 * entries, v.z);
-            atomicAdd(dst + 3 * entries, v.w);
+            __half2* dst = acc_h + nb_grid_corner_entry(lv, cell[k], c); // coarse levels start at entry 0
+            atomicAdd(dst, __floats2half2_rn(v.x, v.y));
+            atomicAdd(dst + entries, __floats2half2_rn(v.z, v.w));
         }
     }
 }
 
-__global__ void k_grid_backward_coarse(DevNetwork net, DevBatch b, uint32_t coarse_levels, uint32_t coarse_values,
-                                       uint32_t* flag) {
-    extern __shared__ float acc_s[];
-    for (uint32_t v = threadIdx.x; v < coarse_values; v += blockDim.x) acc_s[v] = 0.0f;
+// 2 blocks of 512 per SM: 64 registers (24 bytes spilled; unbounded, nvcc gives it 72, one block per SM,
+// and the kernel ran 0.44 instead of 0.40 ms).
+__global__ void __launch_bounds__(512, 2)
+    k_grid_backward_coarse(DevNetwork net, DevBatch b, uint32_t coarse_levels, uint32_t coarse_values,
+                           uint32_t* flag) {
+    extern __shared__ __half2 acc_h[];
+    for (uint32_t v = threadIdx.x; v < coarse_values / 2; v += blockDim.x)
+        acc_h[v] = __floats2half2_rn(0.0f, 0.0f);
     __syncthreads();
     // One thread per (sample, coarse level); the shared-memory atomics bound this kernel
     // (results/cuda_training.md), and merging the points of one cell cuts them by up to 3x.
@@ -163,13 +171,15 @@ __global__ void k_grid_backward_coarse(DevNetwork net, DevBatch b, uint32_t coar
     for (uint32_t t = blockIdx.x * blockDim.x + threadIdx.x; t < items; t += gridDim.x * blockDim.x) {
         const uint32_t i = t / coarse_levels, l = t % coarse_levels;
         if (b.leaf[i] < 0) continue;
-        coarse_backward_sample_level(net.levels[l], b, i, l, flag, acc_s, entries);
+        coarse_backward_sample_level(net.levels[l], b, i, l, flag, acc_h, entries);
     }
     __syncthreads();
     // One float4 add per touched entry (coarse levels start at entry 0; coarse_values is a multiple of 4).
     for (uint32_t e = threadIdx.x; e < entries; e += blockDim.x) {
-        const float4 v = make_float4(acc_s[e], acc_s[e + entries], acc_s[e + 2 * entries], acc_s[e + 3 * entries]);
+        const float2 lo = __half22float2(acc_h[e]), hi = __half22float2(acc_h[e + entries]);
+        const float4 v = make_float4(lo.x, lo.y, hi.x, hi.y);
         if (v.x == 0.0f && v.y == 0.0f && v.z == 0.0f && v.w == 0.0f) continue;
+        if (!isfinite(v.x + v.y + v.z + v.w)) atomicOr(flag, NB_GUARD_GRADIENT); // an fp16 partial overflowed
 #if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900
         atomicAdd(reinterpret_cast<float4*>(net.grid_grad) + e, v);
 #else
@@ -550,7 +560,7 @@ void launch_grid_backward(const DevNetwork& net, const DevBatch& b, bool determi
         int dev = 0, sms = 1;
         NBVH_CUDA_CHECK(cudaGetDevice(&dev));
         NBVH_CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, dev));
-        k_grid_backward_coarse<<<2 * sms, 512, values * 4, s>>>(net, b, coarse, values, flag);
+        k_grid_backward_coarse<<<2 * sms, 512, values * 2, s>>>(net, b, coarse, values, flag);
         NBVH_CUDA_CHECK(cudaGetLastError());
     }
     if (coarse == NB_GRID_MAX_LEVELS) return;
