@@ -106,7 +106,7 @@ __global__ void k_reduce_mlp(const float* slices, int blocks, float* grad, uint3
 }
 
 // Grid gradient of the deterministic mode: converts the fixed-point sums and checks them (the fast mode's
-// float sums are guarded by the grid backward kernels, see step()).
+// are guarded by the grid backward kernels and k_check_half, see step()).
 __global__ void k_check_grid(float* grad, const unsigned long long* fx, uint32_t n, uint32_t* flag) {
     const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= n) return;
@@ -215,12 +215,12 @@ public:
         NBVH_CHECK_SIZE(c.levels.size() == NB_GRID_MAX_LEVELS && c.mlp.size() == NB_MLP_WEIGHT_COUNT);
         for (uint32_t l = 0; l < NB_GRID_MAX_LEVELS; ++l) {
             net_.levels[l] = c.levels[l];
-            // k_encode reads entry pairs (2e, 2e + 1) as one 16-byte word: even offsets and sizes keep
-            // every pair inside its level's table (level tables are multiples of 8 entries, hashgrid.h).
+            // k_encode reads entry pairs (2e, 2e + 1) as one 16-byte word, the fine grid backward adds to
+            // them with one reduction: even offsets and sizes keep every pair inside its level's table.
             NBVH_CHECK_SIZE(c.levels[l].offset % 2u == 0u && c.levels[l].size % 2u == 0u);
         }
         grid_n_ = uint32_t(c.grid.size());
-        NBVH_CHECK_SIZE(grid_n_ % 8u == 0u); // whole entry pairs (4 values each)
+        NBVH_CHECK_SIZE(grid_n_ % 8u == 0u); // whole entry pairs (8 values each)
         grid_w_.upload(c.grid);
         mlp_w_.upload(c.mlp);
         for (auto* b : {&grid_m_, &grid_v_}) { b->alloc(grid_n_); b->zero_async(grid_n_, stream_); }
@@ -337,14 +337,17 @@ public:
         partials_.alloc(size_t(sblocks) * 6);
         k_stats<<<sblocks, kStatsThreads, 0, s>>>(batch, leaves_, leaf_samples_.p, leaf_loss_fx_.p,
                                                   partials_.p);
-        k_fold_leaf_stats<<<(leaves_ + 255) / 256, 256, 0, s>>>(leaves_, leaf_samples_.p, leaf_loss_fx_.p);
+        if (leaves_ > 0)
+            k_fold_leaf_stats<<<(leaves_ + 255) / 256, 256, 0, s>>>(leaves_, leaf_samples_.p,
+                                                                    leaf_loss_fx_.p);
         k_reduce_mlp<<<(NB_MLP_WEIGHT_COUNT + 255) / 256, 256, 0, s>>>(slices_.p, blocks, mlp_grad_.p, flag);
         // The deterministic sums are converted (and checked) here. In the fast mode the coarse levels' fp32
-        // sums need no pass: both grid backward kernels raise the guard on a non-finite dL/dfeature, and
-        // finite ones cannot overflow an fp32 sum (each is a 64-term fp32 sum of fp16 x fp16 products,
-        // k_mlp's wmma, |x| <= 64 x 65504^2 = 2.7e11, and an entry takes at most 24 weighted (w <= 1) adds
-        // per sample: below FLT_MAX for any batch below 5e25); the fine levels' fp16 sums can overflow and
-        // are checked (half the bytes of the fp32 pass it replaced).
+        // sums need no pass: both grid backward kernels raise the guard on a non-finite dL/dfeature,
+        // k_grid_backward_coarse on a block's fp16 partial that overflowed, and the fp32 sum of finite
+        // partials cannot overflow (each dL/dfeature is a 64-term fp32 sum of fp16 x fp16 products, k_mlp's
+        // wmma, |x| <= 64 x 65504^2 = 2.7e11, and an entry takes at most 24 weighted (w <= 1) adds per
+        // sample: below FLT_MAX for any batch below 5e25); the fine levels' fp16 sums can overflow and are
+        // checked here (half the bytes of the fp32 pass this replaced).
         if (cfg_.deterministic)
             k_check_grid<<<(grid_n_ + 255) / 256, 256, 0, s>>>(grid_grad_.p, grid_grad_fx_.p, grid_n_, flag);
         else if (grid_n_ > split_.values)

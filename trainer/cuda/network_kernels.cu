@@ -99,15 +99,15 @@ __global__ void __launch_bounds__(256, 8) k_encode(DevNetwork net, DevBatch b) {
 // ---------------------------------------------------------------------------------------------
 // Grid backward of the coarse levels (fast mode): their few entries receive thousands of adds per step,
 // which serialise in L2 as global atomics. Each block accumulates its share of the samples in shared
-// memory and flushes one global add per touched value.
+// memory and flushes one global float4 add per touched entry.
 // Which levels are coarse: those whose values would fit this many bytes as fp32 (levels 0-1 of the paper
 // configuration; the fp16 accumulator uses half of it).
 constexpr uint32_t kCoarseSmemBytes = 96 * 1024;
 // The coarse-level backward of one (sample, level): each of the segment's points adds w_c * dL/dfeatures
 // to the 8 corners of its cell in the block's shared accumulator. Points in the same cell (a ray
-// segment's 3 points usually share the coarse levels' cells) are summed in registers first, so the 4
-// shared atomics run once per distinct (cell, corner): up to 3x fewer, the same sum up to float
-// reassociation. Non-finite gradients raise the guard. Not used on the fine levels (k_grid_backward,
+// segment's 3 points usually share the coarse levels' cells) are summed in registers first, so the
+// (two half2) shared atomics run once per distinct (cell, corner): up to 3x fewer. Non-finite
+// gradients raise the guard. Not used on the fine levels (k_grid_backward,
 // one thread per point): there the points rarely share a cell and the merged form measured 1 % slower
 // (H200, results/cuda_training.md).
 // The accumulator holds fp16 pairs, pair-major (features 0-1 of entry e at e, features 2-3 at entries +
