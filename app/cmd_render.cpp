@@ -116,6 +116,7 @@ void write_stats(const std::string& path, const render::RenderStats& s, const Re
         nlohmann::json n;
         n["path"] = s.neural_path;
         n["queries"] = s.neural_queries;
+        n["queries_by_depth"] = s.neural_queries_by_depth; // with pass_gpu_ms_by_depth: queries/s per bounce
         n["rounds"] = s.neural_rounds;
         n["leaf_cap_rays"] = s.neural_leaf_cap_rays;
         n["queries_per_ray"] = s.neural_queries_per_ray();

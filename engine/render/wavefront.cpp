@@ -441,10 +441,11 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
     };
     // The GPU's statistics counters are 32-bit (neural queries: 64-bit, GpuNeuralCounters) and wrap within
     // a long render (a 1080p frame at 4096 spp traces ~1e10 rays): they are read after every submission
-    // (each adds less than 2^32, wave_plan.h counter_safe_paths) and the wrapped differences summed in 64 bits.
-    // [0..6]: primary, secondary, shadow rays, non-finite samples, neural queries, rounds, leaf-cap rays;
-    // then path rays and shadow rays per bounce (NB_STAT_DEPTHS each).
-    constexpr size_t N = 7 + 2 * NB_STAT_DEPTHS;
+    // (each adds less than 2^32, wave_plan.h counter_safe_paths) and the wrapped differences summed in 64
+    // bits. [0..6]: primary, secondary, shadow rays, non-finite samples, neural queries, rounds, leaf-cap
+    // rays; then path rays, shadow rays and neural queries per bounce (NB_STAT_DEPTHS each).
+    static_assert(NB_NL_STAT_DEPTHS == NB_STAT_DEPTHS, "per-bounce statistics");
+    constexpr size_t N = 7 + 3 * NB_STAT_DEPTHS;
     uint64_t totals[N] = {};
     uint64_t last[N] = {};
     // The counters are copied into counter_readback_ at the end of each submission (no extra round trip).
@@ -471,6 +472,8 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
             now[4] = uint64_t(nc.queries_total_hi) << 32 | nc.queries_total;
             now[5] = nc.rounds;
             now[6] = nc.leaf_cap_rays;
+            for (uint32_t d = 0; d < NB_STAT_DEPTHS; ++d)
+                now[7 + 2 * NB_STAT_DEPTHS + d] = nc.queries_by_depth[d];
         }
         for (size_t k = 0; k < N; ++k) {
             totals[k] += k == 4 ? now[k] - last[k] : uint32_t(now[k] - last[k]);
@@ -530,6 +533,8 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
         s.neural_queries = totals[4];
         s.neural_rounds = totals[5];
         s.neural_leaf_cap_rays = totals[6];
+        s.neural_queries_by_depth.assign(totals + 7 + 2 * NB_STAT_DEPTHS,
+                                         totals + 7 + 2 * NB_STAT_DEPTHS + depths);
         for (const auto& [name, ms] : pass_ms)
             if (name == PASS_SHADERS[NEURAL_QUERY]) s.neural_query_ms += ms;
     }

@@ -85,6 +85,7 @@ struct RenderStats {
     // GPU time of the neural query passes (queries/s = neural_queries / neural_query_ms).
     std::string neural_path;
     uint64_t neural_queries = 0, neural_rounds = 0;
+    std::vector<uint64_t> neural_queries_by_depth; // per bounce, as rays_by_depth (their sum: neural_queries)
     uint64_t neural_leaf_cap_rays = 0; // rays truncated by the leaf budget (--neural-max-leaves)
     double neural_query_ms = 0.0;
     double neural_queries_per_ray() const {

@@ -150,6 +150,18 @@ TEST(HybridRender, TailPassMatchesBatchedRounds) {
     EXPECT_LT(f0, 1e-3f);
     EXPECT_EQ(all_batched.stats.neural_queries, one.stats.neural_queries);
     EXPECT_EQ(all_batched.stats.neural_queries, tail.stats.neural_queries);
+    // The per-bounce query counts (neural_args.comp counts the batched rounds', neural_tail.comp the
+    // tail's): the same per bounce whichever pass made the queries, summing to the total.
+    for (const Rendered* r : {&all_batched, &one, &tail}) {
+        ASSERT_EQ(r->stats.neural_queries_by_depth.size(), r->stats.rays_by_depth.size());
+        uint64_t sum = 0;
+        for (uint64_t q : r->stats.neural_queries_by_depth) sum += q;
+        EXPECT_EQ(sum, r->stats.neural_queries);
+    }
+    EXPECT_EQ(all_batched.stats.neural_queries_by_depth, one.stats.neural_queries_by_depth);
+    EXPECT_EQ(all_batched.stats.neural_queries_by_depth, tail.stats.neural_queries_by_depth);
+    EXPECT_GT(all_batched.stats.neural_queries_by_depth.at(0), 0u);
+    EXPECT_GT(all_batched.stats.neural_queries_by_depth.at(1), 0u);
 }
 
 // The leaf-cap counter (RenderStats::neural_leaf_cap_rays) counts rays truncated by their leaf budget:
