@@ -95,18 +95,32 @@ __global__ void k_fold_leaf_stats(uint32_t leaves, uint32_t* leaf_samples, unsig
     leaf_loss_fx[l] = fx;
 }
 
-// MLP gradient = sum of the per-block slices in block order (deterministic), checked for finiteness.
-__global__ void k_reduce_mlp(const float* slices, int blocks, float* grad, uint32_t* flag) {
-    const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= NB_MLP_WEIGHT_COUNT) return;
-    float s = 0.0f;
-    for (int k = 0; k < blocks; ++k) s += slices[size_t(k) * NB_MLP_WEIGHT_COUNT + i];
-    grad[i] = s;
-    if (!isfinite(s)) atomicOr(flag, NB_GUARD_GRADIENT);
+// MLP gradient = sum of the per-block slices in block order (deterministic), checked for finiteness
+// (blocks [0, reduce_blocks)); the fast mode's fp16 grid gradient (fine levels, [first, n), 8 values per
+// thread) checked too, as fp16 sums can overflow (the other blocks). One launch for both.
+__global__ void k_reduce_check(const float* slices, int slice_count, float* grad, uint32_t reduce_blocks,
+                               const __half* grad_h, uint32_t first, uint32_t n, uint32_t* flag) {
+    if (blockIdx.x < reduce_blocks) {
+        const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+        if (i >= NB_MLP_WEIGHT_COUNT) return;
+        float s = 0.0f;
+        for (int k = 0; k < slice_count; ++k) s += slices[size_t(k) * NB_MLP_WEIGHT_COUNT + i];
+        grad[i] = s;
+        if (!isfinite(s)) atomicOr(flag, NB_GUARD_GRADIENT);
+        return;
+    }
+    const uint32_t i = first + 8u * ((blockIdx.x - reduce_blocks) * blockDim.x + threadIdx.x);
+    if (i >= n) return;
+    const uint4 q = *reinterpret_cast<const uint4*>(grad_h + i); // first, n: multiples of 8
+    // An fp16 value is inf or NaN exactly when its exponent bits are all set.
+    bool bad = false;
+    for (const uint32_t w : {q.x, q.y, q.z, q.w})
+        bad = bad || (w & 0x7C00u) == 0x7C00u || (w & 0x7C000000u) == 0x7C000000u;
+    if (bad) atomicOr(flag, NB_GUARD_GRADIENT);
 }
 
 // Grid gradient of the deterministic mode: converts the fixed-point sums and checks them (the fast mode's
-// are guarded by the grid backward kernels and k_check_half, see step()).
+// are guarded by the grid backward kernels and k_reduce_check, see step()).
 __global__ void k_check_grid(float* grad, const unsigned long long* fx, uint32_t n, uint32_t* flag) {
     const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= n) return;
@@ -115,31 +129,93 @@ __global__ void k_check_grid(float* grad, const unsigned long long* fx, uint32_t
     if (!isfinite(g)) atomicOr(flag, NB_GUARD_GRADIENT);
 }
 
-// The fast mode's fp16 grid gradient (fine levels): fp16 sums can overflow, so they are checked.
-__global__ void k_check_half(const __half* grad, uint32_t first, uint32_t n, uint32_t* flag) {
-    const uint32_t i = first + blockIdx.x * blockDim.x + threadIdx.x;
-    if (i < n && !isfinite(__half2float(grad[i]))) atomicOr(flag, NB_GUARD_GRADIENT);
+// Adam's bias-correction factors for per-parameter steps t < kAdamBiasTable, computed once by the same
+// functions k_adam would call (so the same values): nb_adam_update reads them instead of two powf per
+// parameter; a t beyond the table computes them.
+constexpr uint32_t kAdamBiasTable = 1u << 16;
+__global__ void k_adam_bias_tables(float beta1, float beta2, float* bias_sqrt, float* bias_div) {
+    const uint32_t t = blockIdx.x * blockDim.x + threadIdx.x;
+    if (t >= kAdamBiasTable) return;
+    bias_sqrt[t] = nb_adam_bias_sqrt(beta2, t);
+    bias_div[t] = nb_adam_bias_div(beta1, t);
 }
 
-// tcnn Adam: nb_adam_update of engine/neural/shared/adam_update.h, the CPU's update (per-parameter step
-// counters; sparse skip of zero grid grads) on the batch-mean gradient (summed gradient / (loss scale x
-// trained samples)), then the fp16 copy. Does nothing when the guard flag is set or no sample was trained.
-// The gradient of parameter i is grad[i] below `split`, grad_h[i] (fp16) from it on.
-__global__ void k_adam(float* w, float* m, float* v, uint32_t* t, __half* wh, const float* grad,
-                       const __half* grad_h, uint32_t split, uint32_t n, GpuAdamRule r, float scale_inv,
-                       const uint32_t* flag, const uint32_t* valid) {
-    const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= n || *flag != 0u || *valid == 0u) return;
-    float wi = w[i], mi = m[i], vi = v[i];
-    uint32_t ti = t[i];
-    const float g = i < split ? grad[i] : __half2float(grad_h[i]);
-    if (!nb_adam_update(wi, mi, vi, ti, g * (scale_inv / float(*valid)), r, nullptr, nullptr, 0u)) return;
-    m[i] = mi;
-    v[i] = vi;
-    t[i] = ti;
-    w[i] = wi;
-    wh[i] = __float2half_rn(wi);
+// One parameter group of an Adam launch (the MLP's or the grid's). The gradient of parameter i is
+// grad[i] below `split`, grad_h[i] (fp16) from it on; split and n are multiples of 4.
+struct AdamGroup {
+    float *w, *m, *v;
+    uint32_t* t;
+    __half* wh;
+    const float* grad;
+    const __half* grad_h;
+    uint32_t split, n;
+    GpuAdamRule r;
+};
+
+// Parameters 4q .. 4q + 3 of group g: nb_adam_update of engine/neural/shared/adam_update.h, the CPU's
+// update, on the batch-mean gradient (summed gradient x scale), then the fp16 copy. 16-byte accesses;
+// the gradient is read first, so a quad whose gradients are all 0 (skipped grid entries) reads nothing
+// else. A quad with some skipped parameters writes their unchanged values back.
+__device__ inline void adam_quad(const AdamGroup& g, uint32_t q, float scale, const float* bias_sqrt,
+                                 const float* bias_div) {
+    const uint32_t i = 4u * q;
+    if (i >= g.n) return;
+    float gr[4];
+    if (i < g.split) {
+        const float4 x = *reinterpret_cast<const float4*>(g.grad + i);
+        gr[0] = x.x;
+        gr[1] = x.y;
+        gr[2] = x.z;
+        gr[3] = x.w;
+    } else {
+        const uint2 x = *reinterpret_cast<const uint2*>(g.grad_h + i);
+        const float2 lo = __half22float2(*reinterpret_cast<const __half2*>(&x.x));
+        const float2 hi = __half22float2(*reinterpret_cast<const __half2*>(&x.y));
+        gr[0] = lo.x;
+        gr[1] = lo.y;
+        gr[2] = hi.x;
+        gr[3] = hi.y;
+    }
+    if (g.r.skip_zero != 0u && gr[0] == 0.0f && gr[1] == 0.0f && gr[2] == 0.0f && gr[3] == 0.0f) return;
+    float4 w = *reinterpret_cast<const float4*>(g.w + i);
+    float4 m = *reinterpret_cast<const float4*>(g.m + i);
+    float4 v = *reinterpret_cast<const float4*>(g.v + i);
+    uint4 t = *reinterpret_cast<const uint4*>(g.t + i);
+    float* pw[4] = {&w.x, &w.y, &w.z, &w.w};
+    float* pm[4] = {&m.x, &m.y, &m.z, &m.w};
+    float* pv[4] = {&v.x, &v.y, &v.z, &v.w};
+    uint32_t* pt[4] = {&t.x, &t.y, &t.z, &t.w};
+#pragma unroll
+    for (int k = 0; k < 4; ++k)
+        nb_adam_update(*pw[k], *pm[k], *pv[k], *pt[k], gr[k] * scale, g.r, bias_sqrt, bias_div,
+                       kAdamBiasTable);
+    *reinterpret_cast<float4*>(g.w + i) = w;
+    *reinterpret_cast<float4*>(g.m + i) = m;
+    *reinterpret_cast<float4*>(g.v + i) = v;
+    *reinterpret_cast<uint4*>(g.t + i) = t;
+    const __half2 h0 = __floats2half2_rn(w.x, w.y), h1 = __floats2half2_rn(w.z, w.w);
+    uint2 h;
+    h.x = *reinterpret_cast<const uint32_t*>(&h0);
+    h.y = *reinterpret_cast<const uint32_t*>(&h1);
+    *reinterpret_cast<uint2*>(g.wh + i) = h;
 }
+
+// tcnn Adam over both parameter groups in one launch (blocks [0, a_blocks) group a, the rest group b),
+// per-parameter step counters and the sparse skip of zero grid gradients (adam_update.h), on the summed
+// gradient / (loss scale x trained samples). Does nothing when the guard flag is set or no sample was
+// trained.
+constexpr uint32_t kAdamThreads = 256;
+__global__ void __launch_bounds__(kAdamThreads)
+    k_adam(AdamGroup a, AdamGroup b, uint32_t a_blocks, float scale_inv, const float* bias_sqrt,
+           const float* bias_div, const uint32_t* flag, const uint32_t* valid) {
+    if (*flag != 0u || *valid == 0u) return;
+    const float scale = scale_inv / float(*valid);
+    if (blockIdx.x < a_blocks)
+        adam_quad(a, blockIdx.x * kAdamThreads + threadIdx.x, scale, bias_sqrt, bias_div);
+    else
+        adam_quad(b, (blockIdx.x - a_blocks) * kAdamThreads + threadIdx.x, scale, bias_sqrt, bias_div);
+}
+uint32_t adam_blocks(uint32_t n) { return (n / 4u + kAdamThreads - 1u) / kAdamThreads; }
 
 // One batch of training samples (sampling + ground truth output) with the per-draw counters of its
 // sampling pass. Two slots: the step trains one while the next step's batch is drawn into the other.
@@ -149,6 +225,7 @@ struct BatchSlot {
     DevBuf<uint32_t> cut, leaf_draws, scalars; // scalars: [0..1] draws (u64), [2] valid samples
     float* keep_host = nullptr;                // pinned staging of the keep probabilities it was drawn with
     size_t keep_host_n = 0;
+    cudaEvent_t sampled{};                     // recorded after its sampling (rays, segment points)
     cudaEvent_t ready{};                       // recorded after its ground truth
     DevBatch batch{};
     // What it holds (a prefetched batch is used only when all of these match the step).
@@ -161,6 +238,7 @@ struct BatchSlot {
     BatchSlot& operator=(const BatchSlot&) = delete;
     ~BatchSlot() {
         if (keep_host) cudaFreeHost(keep_host);
+        if (sampled) cudaEventDestroy(sampled);
         if (ready) cudaEventDestroy(ready);
     }
     unsigned long long* draws() { return reinterpret_cast<unsigned long long*>(scalars.p); }
@@ -175,6 +253,7 @@ public:
         for (auto& e : ev_) NBVH_CUDA_CHECK(cudaEventCreate(&e));
         NBVH_CUDA_CHECK(cudaEventCreateWithFlags(&mlp_done_, cudaEventDisableTiming));
         for (BatchSlot& b : slots_) {
+            NBVH_CUDA_CHECK(cudaEventCreateWithFlags(&b.sampled, cudaEventDisableTiming));
             NBVH_CUDA_CHECK(cudaEventCreateWithFlags(&b.ready, cudaEventDisableTiming));
             b.scalars.alloc(4);
         }
@@ -232,18 +311,25 @@ public:
         k_to_half<<<(grid_n_ + 255) / 256, 256, 0, stream_>>>(grid_w_.p, grid_h_.p, grid_n_);
         k_to_half<<<(NB_MLP_WEIGHT_COUNT + 255) / 256, 256, 0, stream_>>>(mlp_w_.p, mlp_h_.p, NB_MLP_WEIGHT_COUNT);
         NBVH_CUDA_CHECK(cudaGetLastError());
-        grid_grad_.alloc(grid_n_);
         if (c.deterministic) { grid_grad_fx_.alloc(grid_n_); grid_grad_fx_.zero_async(grid_n_, stream_); }
         mlp_grad_.alloc(NB_MLP_WEIGHT_COUNT);
         net_.grid_h = grid_h_.p;
         net_.mlp_h = mlp_h_.p;
-        net_.grid_grad = grid_grad_.p;
         split_ = coarse_split(net_, c.deterministic);
+        // fp32 gradient: every value in the deterministic mode, the coarse levels' in the fast mode (whose
+        // fine levels' gradient is fp16, indexed like the grid).
+        grid_grad_.alloc(grid_split());
+        net_.grid_grad = grid_grad_.p;
         if (!c.deterministic) grid_grad_h_.alloc(grid_n_);
         net_.grid_grad_h = c.deterministic ? nullptr : grid_grad_h_.p;
         net_.grid_grad_fx = c.deterministic ? grid_grad_fx_.p : nullptr;
         net_.grid_values = grid_n_;
         flag_.alloc(1);
+        bias_sqrt_.alloc(kAdamBiasTable);
+        bias_div_.alloc(kAdamBiasTable);
+        k_adam_bias_tables<<<kAdamBiasTable / 256, 256, 0, stream_>>>(c.beta1, c.beta2, bias_sqrt_.p,
+                                                                      bias_div_.p);
+        NBVH_CUDA_CHECK(cudaGetLastError());
         NBVH_CUDA_CHECK(cudaStreamSynchronize(stream_));
     }
     ~CoreImpl() override {
@@ -285,8 +371,9 @@ public:
             const BatchSlot& b = slots_[k];
             if (b.filled && b.step == in.step && b.n == n && b.seed == in.seed && b.cut_gen == cut_gen_) cur = k;
         }
-        if (cur >= 0 && !timing_) {
-            NBVH_CUDA_CHECK(cudaStreamWaitEvent(s, slots_[cur].ready, 0));
+        const bool prefetched = cur >= 0 && !timing_;
+        if (prefetched) {
+            NBVH_CUDA_CHECK(cudaStreamWaitEvent(s, slots_[cur].sampled, 0));
         } else {
             NBVH_CUDA_CHECK(cudaStreamSynchronize(side_)); // a mismatching batch in flight may use slot 0
             cur = 0;
@@ -311,10 +398,12 @@ public:
             grid_grad_h_.zero_async(grid_n_, s);
         }
         const int blocks = mlp_blocks_for(n);
-        slices_.alloc(size_t(blocks) * NB_MLP_WEIGHT_COUNT);
-        slices_.zero_async(size_t(blocks) * NB_MLP_WEIGHT_COUNT, s);
+        slices_.alloc(size_t(blocks) * NB_MLP_WEIGHT_COUNT); // k_mlp writes every value of its block's slice
 
         launch_encode(net_, batch, s);
+        // A batch drawn ahead: the encode needs its rays and points, the fused MLP its targets as well,
+        // so the encode runs beside that batch's ground truth.
+        if (prefetched) NBVH_CUDA_CHECK(cudaStreamWaitEvent(s, slot.ready, 0));
         record(3);
         const LossParams lp{cfg_.loss, scale_};
         launch_mlp(net_, batch, lp, slices_.p, blocks, flag, s);
@@ -340,28 +429,37 @@ public:
         if (leaves_ > 0)
             k_fold_leaf_stats<<<(leaves_ + 255) / 256, 256, 0, s>>>(leaves_, leaf_samples_.p,
                                                                     leaf_loss_fx_.p);
-        k_reduce_mlp<<<(NB_MLP_WEIGHT_COUNT + 255) / 256, 256, 0, s>>>(slices_.p, blocks, mlp_grad_.p, flag);
-        // The deterministic sums are converted (and checked) here. In the fast mode the coarse levels' fp32
-        // sums need no pass: both grid backward kernels raise the guard on a non-finite dL/dfeature,
-        // k_grid_backward_coarse on a block's fp16 partial that overflowed, and the fp32 sum of finite
-        // partials cannot overflow (each dL/dfeature is a 64-term fp32 sum of fp16 x fp16 products, k_mlp's
-        // wmma, |x| <= 64 x 65504^2 = 2.7e11, and an entry takes at most 24 weighted (w <= 1) adds per
-        // sample: below FLT_MAX for any batch below 5e25); the fine levels' fp16 sums can overflow and are
-        // checked here (half the bytes of the fp32 pass this replaced).
+        // The deterministic sums are converted (and checked) by k_check_grid. In the fast mode the coarse
+        // levels' fp32 sums need no pass: both grid backward kernels raise the guard on a non-finite
+        // dL/dfeature, k_grid_backward_coarse on a block's fp16 partial that overflowed, and the fp32 sum of
+        // finite partials cannot overflow (each dL/dfeature is a 64-term fp32 sum of fp16 x fp16 products,
+        // k_mlp's wmma, |x| <= 64 x 65504^2 = 2.7e11, and an entry takes at most 24 weighted (w <= 1) adds
+        // per sample: below FLT_MAX for any batch below 5e25); the fine levels' fp16 sums can overflow and
+        // are checked by k_reduce_check, which also sums the MLP gradient's slices.
+        const uint32_t reduce_blocks = (NB_MLP_WEIGHT_COUNT + 255) / 256;
+        const uint32_t fine = cfg_.deterministic ? 0u : grid_n_ - split_.values;
+        k_reduce_check<<<reduce_blocks + (fine / 8u + 255u) / 256u, 256, 0, s>>>(
+            slices_.p, blocks, mlp_grad_.p, reduce_blocks, grid_grad_h_.p, split_.values, grid_n_, flag);
         if (cfg_.deterministic)
             k_check_grid<<<(grid_n_ + 255) / 256, 256, 0, s>>>(grid_grad_.p, grid_grad_fx_.p, grid_n_, flag);
-        else if (grid_n_ > split_.values)
-            k_check_half<<<(grid_n_ - split_.values + 255) / 256, 256, 0, s>>>(grid_grad_h_.p, split_.values,
-                                                                               grid_n_, flag);
         const GpuAdamRule mlp_rule{in.learning_rate, cfg_.beta1, cfg_.beta2, cfg_.epsilon, cfg_.l2_reg, 0u};
         const GpuAdamRule grid_rule{in.learning_rate, cfg_.beta1, cfg_.beta2, cfg_.epsilon, cfg_.non_matrix_l2_reg,
                                     cfg_.skip_zero_grad_non_matrix ? 1u : 0u};
-        k_adam<<<(NB_MLP_WEIGHT_COUNT + 255) / 256, 256, 0, s>>>(
-            mlp_w_.p, mlp_m_.p, mlp_v_.p, mlp_t_.p, mlp_h_.p, mlp_grad_.p, nullptr, NB_MLP_WEIGHT_COUNT,
-            NB_MLP_WEIGHT_COUNT, mlp_rule, 1.0f / scale_, flag, valid);
-        k_adam<<<(grid_n_ + 255) / 256, 256, 0, s>>>(grid_w_.p, grid_m_.p, grid_v_.p, grid_t_.p, grid_h_.p,
-                                                     grid_grad_.p, grid_grad_h_.p, grid_split(), grid_n_,
-                                                     grid_rule, 1.0f / scale_, flag, valid);
+        const AdamGroup mlp{mlp_w_.p,
+                            mlp_m_.p,
+                            mlp_v_.p,
+                            mlp_t_.p,
+                            mlp_h_.p,
+                            mlp_grad_.p,
+                            nullptr,
+                            NB_MLP_WEIGHT_COUNT,
+                            NB_MLP_WEIGHT_COUNT,
+                            mlp_rule};
+        const AdamGroup grid{grid_w_.p,    grid_m_.p,      grid_v_.p,    grid_t_.p, grid_h_.p,
+                             grid_grad_.p, grid_grad_h_.p, grid_split(), grid_n_,   grid_rule};
+        const uint32_t mlp_blocks = adam_blocks(NB_MLP_WEIGHT_COUNT);
+        k_adam<<<mlp_blocks + adam_blocks(grid_n_), kAdamThreads, 0, s>>>(
+            mlp, grid, mlp_blocks, 1.0f / scale_, bias_sqrt_.p, bias_div_.p, flag, valid);
         NBVH_CUDA_CHECK(cudaGetLastError());
         record(6);
 
@@ -447,7 +545,8 @@ public:
         mlp_grad.resize(NB_MLP_WEIGHT_COUNT);
         grid_grad.resize(grid_n_);
         NBVH_CUDA_CHECK(cudaMemcpy(mlp_grad.data(), mlp_grad_.p, mlp_grad.size() * 4, cudaMemcpyDeviceToHost));
-        NBVH_CUDA_CHECK(cudaMemcpy(grid_grad.data(), grid_grad_.p, grid_grad.size() * 4, cudaMemcpyDeviceToHost));
+        NBVH_CUDA_CHECK(
+            cudaMemcpy(grid_grad.data(), grid_grad_.p, size_t(grid_split()) * 4, cudaMemcpyDeviceToHost));
         if (grid_split() < grid_n_) { // the fast mode's fine levels: fp16
             std::vector<__half> h(grid_n_ - grid_split());
             NBVH_CUDA_CHECK(
@@ -475,7 +574,7 @@ private:
     }
 
     // Sampling (first-leaf search, roulette) and ground truth of `step` into `b`, on stream `st`, with
-    // the given keep probabilities of cuts[0]; records b.ready.
+    // the given keep probabilities of cuts[0]; records b.sampled and b.ready.
     void draw_batch(BatchSlot& b, uint32_t step, uint32_t n, uint64_t seed, const std::vector<float>& keep,
                     cudaStream_t st) {
         b.origin.alloc(3 * size_t(n)); b.dir.alloc(3 * size_t(n)); b.len.alloc(n);
@@ -505,6 +604,7 @@ private:
         if (st == stream_) record(0);
         launch_sample(da_, dc, b.batch, n, seed, step, b.draws(), b.valid(), st);
         if (st == stream_) record(1);
+        NBVH_CUDA_CHECK(cudaEventRecord(b.sampled, st));
         launch_ground_truth(da_, b.batch, seed, step, st);
         if (st == stream_) record(2);
         NBVH_CUDA_CHECK(cudaEventRecord(b.ready, st));
@@ -548,6 +648,7 @@ private:
     // Parameters below this index take the fp32 gradient (all in the deterministic mode).
     uint32_t grid_split() const { return cfg_.deterministic ? grid_n_ : split_.values; }
     DevBuf<double> partials_;
+    DevBuf<float> bias_sqrt_, bias_div_; // Adam's bias-correction factors per step t (k_adam_bias_tables)
     DevBuf<float> b_dfeat_, b_loss_; // features (b_feat_ above), dL/dfeature and losses: network part only
 };
 

@@ -140,7 +140,22 @@ __device__ Attempt try_attempt(const DevAsset& a, const DevCuts& c, const Sample
     return r;
 }
 
-__device__ void write_sample(const DevBatch& b, uint32_t i, vec3 so, vec3 sd, float len, int32_t leaf, uint32_t cut) {
+// A slot's sample and its segment's encoded points (zero for a starved slot, leaf -1): everything the
+// encode reads, so that it can run beside the batch's ground truth (cuda_core.cu).
+__device__ void write_sample(const DevAsset& a, const DevBatch& b, uint32_t i, vec3 so, vec3 sd, float len,
+                             int32_t leaf, uint32_t cut) {
+    vec3 p0(0.0f), p1(0.0f), p2(0.0f);
+    if (leaf >= 0) nb_segment_points(a.enc, so, sd, 0.0f, len, p0, p1, p2);
+    float* pp = b.points + 9 * size_t(i);
+    pp[0] = p0.x;
+    pp[1] = p0.y;
+    pp[2] = p0.z;
+    pp[3] = p1.x;
+    pp[4] = p1.y;
+    pp[5] = p1.z;
+    pp[6] = p2.x;
+    pp[7] = p2.y;
+    pp[8] = p2.z;
     b.origin[3 * i] = so.x; b.origin[3 * i + 1] = so.y; b.origin[3 * i + 2] = so.z;
     b.dir[3 * i] = sd.x; b.dir[3 * i + 1] = sd.y; b.dir[3 * i + 2] = sd.z;
     b.length[i] = len;
@@ -207,7 +222,7 @@ __global__ void k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint
                 if (r.cut == 0u && r.f.leaf >= 0) atomicAdd(&c.leaf_draws[r.f.leaf], 1u);
             }
             if (success && lane == first)
-                write_sample(b, warp_base + owner, r.o + r.d * r.f.t_entry, r.d,
+                write_sample(a, b, warp_base + owner, r.o + r.d * r.f.t_entry, r.d,
                              fmaxf(r.f.t_exit - r.f.t_entry, 0.0f), r.f.leaf, r.cut);
             if (open) { // as the owner: done, or the attempts this round took
                 const uint32_t my_rank = uint32_t(__popc(open_mask & ((1u << lane) - 1u)));
@@ -219,7 +234,7 @@ __global__ void k_sample(DevAsset a, DevCuts c, DevBatch b, uint32_t batch, uint
                     next += uint32_t(__popc(lanes));
                     if (next >= kMaxSampleAttempts) { // starved: no reachable leaf
                         open = false;
-                        write_sample(b, slot, vec3(0.0f), vec3(0.0f), 0.0f, -1, 0u);
+                        write_sample(a, b, slot, vec3(0.0f), vec3(0.0f), 0.0f, -1, 0u);
                     }
                 }
             }
@@ -437,7 +452,6 @@ __global__ void __launch_bounds__(128, 8)
     float tg[8] = {0, 0, 0, 0, 0, 0, 0, 0};
     const vec3 o = load3(b.origin + 3 * i), d = load3(b.dir + 3 * i);
     const float len = b.length[i];
-    vec3 p0(0.0f), p1(0.0f), p2(0.0f);
     if (b.leaf[i] >= 0) {
         float t = 0.0f, u = 0.0f, v = 0.0f;
         uint32_t tri = 0;
@@ -477,12 +491,8 @@ __global__ void __launch_bounds__(128, 8)
             tg[2] = (n.x + 1.0f) * 0.5f; tg[3] = (n.y + 1.0f) * 0.5f; tg[4] = (n.z + 1.0f) * 0.5f;
             tg[5] = al.x; tg[6] = al.y; tg[7] = al.z;
         }
-        nb_segment_points(a.enc, o, d, 0.0f, len, p0, p1, p2);
     }
     for (int k = 0; k < 8; ++k) b.target[8 * i + k] = tg[k];
-    float* pp = b.points + 9 * size_t(i);
-    pp[0] = p0.x; pp[1] = p0.y; pp[2] = p0.z; pp[3] = p1.x; pp[4] = p1.y; pp[5] = p1.z;
-    pp[6] = p2.x; pp[7] = p2.y; pp[8] = p2.z;
 }
 
 } // namespace
