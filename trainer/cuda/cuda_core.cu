@@ -216,6 +216,7 @@ __global__ void __launch_bounds__(kAdamThreads)
         adam_quad(b, (blockIdx.x - a_blocks) * kAdamThreads + threadIdx.x, scale, bias_sqrt, bias_div);
 }
 uint32_t adam_blocks(uint32_t n) { return (n / 4u + kAdamThreads - 1u) / kAdamThreads; }
+static_assert(NB_MLP_WEIGHT_COUNT % 4u == 0u, "k_adam takes the MLP's parameters four at a time");
 
 // One batch of training samples (sampling + ground truth output) with the per-draw counters of its
 // sampling pass. Two slots: the step trains one while the next step's batch is drawn into the other.
