@@ -48,13 +48,8 @@ void expect_adam_matches_host(bool deterministic) {
     size_t skipped_grid_entries = 0;
     for (uint32_t s = 0; s < 4; ++s) {
         SCOPED_TRACE("step " + std::to_string(s));
-        StepParams p;
-        p.step = s;
-        p.batch_size = 2000; // a few grid entries untouched per step: their counters fall behind
-        p.seed = 11;
-        p.cuts = {&cut};
-        p.cut_version = 1;
-        const StepStats st = gpu->step(p);
+        // 2,000 rays: a few grid entries untouched per step, whose counters fall behind.
+        const StepStats st = gpu->step(test::fixed_cut_step(s, 2000, 11, cut));
         ASSERT_FALSE(st.skipped) << st.skip_reason;
         std::vector<CudaDebugSample> samples;
         std::vector<float> mg, gg;

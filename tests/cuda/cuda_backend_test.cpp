@@ -24,6 +24,7 @@ namespace nbvh {
 namespace {
 
 using test::cut_at_depth;
+using test::fixed_cut_step;
 
 Scene load_bunny() {
     SceneLoadOptions lo;
@@ -241,17 +242,6 @@ TEST(CudaBackend, NormalMapGroundTruthMatchesTheCpu) {
     });
     std::printf("samples whose normal the map moves: %u of %u\n", moved, p.batch_size);
     EXPECT_GT(moved, p.batch_size / 50);
-}
-
-// Step `step` of `batch` samples on the one cut `cut` (cut version 1).
-StepParams fixed_cut_step(uint32_t step, uint32_t batch, uint64_t seed, const TrainingCut& cut) {
-    StepParams p;
-    p.step = step;
-    p.batch_size = batch;
-    p.seed = seed;
-    p.cuts = {&cut};
-    p.cut_version = 1;
-    return p;
 }
 
 TEST(CudaBackend, DeterministicModeIsBitReproducible) {

@@ -1,4 +1,5 @@
-// Shared by the CUDA trainer tests: the skip without a GPU (and test_cuts.h: a fixed N-BVH cut).
+// Shared by the CUDA trainer tests: the skip without a GPU, a step on one fixed cut (and test_cuts.h: a
+// fixed N-BVH cut).
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -14,3 +15,18 @@
     do {                                                                                         \
         if (!::nbvh::cuda_backend_available()) GTEST_SKIP() << "no usable CUDA GPU";            \
     } while (0)
+
+namespace nbvh::test {
+
+// Step `step` of `batch` samples on the one cut `cut` (cut version 1).
+inline StepParams fixed_cut_step(uint32_t step, uint32_t batch, uint64_t seed, const TrainingCut& cut) {
+    StepParams p;
+    p.step = step;
+    p.batch_size = batch;
+    p.seed = seed;
+    p.cuts = {&cut};
+    p.cut_version = 1;
+    return p;
+}
+
+} // namespace nbvh::test
