@@ -235,6 +235,10 @@ public:
         core_->read_weights(out.mlp, out.grid);
     }
 
+    void read_half_weights(std::vector<uint16_t>& mlp, std::vector<uint16_t>& grid) const override {
+        core_->read_half_weights(mlp, grid);
+    }
+
     void read_last_step(std::vector<CudaDebugSample>& samples, std::vector<float>& mlp_grad,
                         std::vector<float>& grid_grad) const override {
         std::vector<cuda::CoreSample> cs;

@@ -44,6 +44,8 @@ public:
     // Samples and batch-mean gradients (MLP, grid; loss scale removed) of the last step.
     virtual void read_last_step(std::vector<CudaDebugSample>& samples, std::vector<float>& mlp_grad,
                                 std::vector<float>& grid_grad) const = 0;
+    // The fp16 copies of the weights the kernels read (bits; MLP, grid), refreshed by every Adam step.
+    virtual void read_half_weights(std::vector<uint16_t>& mlp, std::vector<uint16_t>& grid) const = 0;
     virtual void set_timing(bool on) = 0;
     virtual CudaPhaseTimes phase_times() const = 0;
     virtual float loss_scale() const = 0;

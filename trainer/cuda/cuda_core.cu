@@ -317,6 +317,9 @@ public:
         net_.grid_h = grid_h_.p;
         net_.mlp_h = mlp_h_.p;
         split_ = coarse_split(net_, c.deterministic);
+        // k_reduce_check reads the fp16 gradient 8 values at a time from split_.values, k_adam 4 at a time:
+        // level offsets and sizes are even, so (offset + size) x 4 features is a multiple of 8.
+        NBVH_CHECK_SIZE(split_.values % 8u == 0u);
         // fp32 gradient: every value in the deterministic mode, the coarse levels' in the fast mode (whose
         // fine levels' gradient is fp16, indexed like the grid).
         grid_grad_.alloc(grid_split());
@@ -519,6 +522,12 @@ public:
         grid.resize(grid_n_);
         NBVH_CUDA_CHECK(cudaMemcpy(mlp.data(), mlp_w_.p, mlp.size() * 4, cudaMemcpyDeviceToHost));
         NBVH_CUDA_CHECK(cudaMemcpy(grid.data(), grid_w_.p, grid.size() * 4, cudaMemcpyDeviceToHost));
+    }
+    void read_half_weights(std::vector<uint16_t>& mlp, std::vector<uint16_t>& grid) const override {
+        mlp.resize(NB_MLP_WEIGHT_COUNT);
+        grid.resize(grid_n_);
+        NBVH_CUDA_CHECK(cudaMemcpy(mlp.data(), mlp_h_.p, mlp.size() * 2, cudaMemcpyDeviceToHost));
+        NBVH_CUDA_CHECK(cudaMemcpy(grid.data(), grid_h_.p, grid.size() * 2, cudaMemcpyDeviceToHost));
     }
 
     void read_last(std::vector<CoreSample>& samples, std::vector<float>& mlp_grad,

@@ -117,6 +117,8 @@ public:
     virtual void set_cuts(const std::vector<CoreCut>& cuts) = 0;
     virtual void step(const CoreStepIn& in, CoreStepOut& out) = 0;
     virtual void read_weights(std::vector<float>& mlp, std::vector<float>& grid) const = 0;
+    // Debug: the fp16 copies of the weights the kernels read (bits), refreshed by Adam.
+    virtual void read_half_weights(std::vector<uint16_t>& mlp, std::vector<uint16_t>& grid) const = 0;
     // Debug: samples and normalised gradients of the last step (call after step()).
     virtual void read_last(std::vector<CoreSample>& samples, std::vector<float>& mlp_grad,
                            std::vector<float>& grid_grad) const = 0;
