@@ -46,8 +46,14 @@ constexpr size_t kSmemTotal = kSmemW + kSmemX0 + 4 * kSmemH + kSmemO + kSmemS;
 
 // ---------------------------------------------------------------------------------------------
 // Grid forward: one thread per (sample, point, level).
-// 32 registers (8 blocks of 256 per SM, as before the paired loads; unbounded, nvcc gives it 40).
-__global__ void __launch_bounds__(256, 8) k_encode(DevNetwork net, DevBatch b) {
+// 32 registers (8 blocks of 256 per SM, as before the paired loads; unbounded, nvcc gives it 40). The
+// SMs of sm_86 / sm_87 / sm_89 hold 1,536 threads: 6 blocks there (38 registers; not measured there).
+#if defined(__CUDA_ARCH__) && (__CUDA_ARCH__ == 860 || __CUDA_ARCH__ == 870 || __CUDA_ARCH__ == 890)
+constexpr int kEncodeBlocksPerSm = 6;
+#else
+constexpr int kEncodeBlocksPerSm = 8;
+#endif
+__global__ void __launch_bounds__(256, kEncodeBlocksPerSm) k_encode(DevNetwork net, DevBatch b) {
     const uint32_t tid = blockIdx.x * blockDim.x + threadIdx.x;
     const uint32_t per = NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS;
     if (tid >= b.n * per) return;
