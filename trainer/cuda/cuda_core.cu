@@ -1,5 +1,5 @@
-// Device memory, step orchestration, gradient reduction, the non-finite guard, Adam and the per-leaf
-// statistics of the CUDA trainer (see cuda_core.h). The network part runs on one stream; the next
+// Device memory and step orchestration of the CUDA trainer (see cuda_core.h; the kernels:
+// sampling_kernels.cu, network_kernels.cu, update_kernels.cu). The network part runs on one stream; the next
 // step's batch (sampling + ground truth) is drawn ahead on a second stream while it runs (prefetch,
 // see CoreConfig::prefetch). The only host syncs of a step are the read-back of the guard flag, the
 // loss partials and the per-leaf statistics at its end.
@@ -9,9 +9,9 @@
 #include <memory>
 
 #include "engine/core/log.h"
-#include "engine/neural/shared/adam_update.h"
 #include "trainer/cuda/cuda_core.h"
 #include "trainer/cuda/device_common.cuh"
+#include "trainer/cuda/update_kernels.cuh"
 
 namespace nbvh::cuda {
 namespace {
@@ -41,182 +41,6 @@ struct DevBuf {
         if (count) NBVH_CUDA_CHECK(cudaMemsetAsync(p, 0, count * sizeof(T), s));
     }
 };
-
-constexpr int kStatsThreads = 256;
-// Copies of the per-leaf counters that k_stats's blocks spread their atomics over (block b adds to copy
-// b % kLeafCopies), folded by k_fold_leaf_stats: a leaf hit by thousands of samples took as many atomics
-// on one address.
-constexpr uint32_t kLeafCopies = 8;
-
-__global__ void k_to_half(const float* src, __half* dst, uint32_t n) {
-    const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i < n) dst[i] = __float2half_rn(src[i]);
-}
-
-// Per-leaf statistics (cuts[0]) and per-block partial sums of the loss terms (fixed reduction order).
-__global__ void k_stats(DevBatch b, uint32_t leaves, uint32_t* leaf_samples, unsigned long long* leaf_loss_fx,
-                        double* partials) {
-    __shared__ double red[6][kStatsThreads];
-    const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-    const size_t copy = size_t(blockIdx.x % kLeafCopies) * leaves;
-    leaf_samples += copy;
-    leaf_loss_fx += copy;
-    double v[6] = {0, 0, 0, 0, 0, 0};
-    if (i < b.n && b.leaf[i] >= 0) {
-        for (int q = 0; q < 5; ++q) v[q] = b.loss[5 * size_t(i) + q];
-        v[5] = b.target[8 * size_t(i)] > 0.5f ? 1.0 : 0.0;
-        if (b.cut[i] == 0) {
-            atomicAdd(&leaf_samples[b.leaf[i]], 1u);
-            atomicAdd(&leaf_loss_fx[b.leaf[i]], (unsigned long long)__double2ll_rn(v[4] * 4294967296.0));
-        }
-    }
-    for (int q = 0; q < 6; ++q) red[q][threadIdx.x] = v[q];
-    __syncthreads();
-    for (int s = kStatsThreads / 2; s > 0; s >>= 1) {
-        if (int(threadIdx.x) < s)
-            for (int q = 0; q < 6; ++q) red[q][threadIdx.x] += red[q][threadIdx.x + s];
-        __syncthreads();
-    }
-    if (threadIdx.x == 0)
-        for (int q = 0; q < 6; ++q) partials[blockIdx.x * 6 + q] = red[q][0];
-}
-
-// Copy 0 of the per-leaf counters += copies 1.. (integer sums: the same totals in any order).
-__global__ void k_fold_leaf_stats(uint32_t leaves, uint32_t* leaf_samples, unsigned long long* leaf_loss_fx) {
-    const uint32_t l = blockIdx.x * blockDim.x + threadIdx.x;
-    if (l >= leaves) return;
-    uint32_t n = 0;
-    unsigned long long fx = 0;
-    for (uint32_t k = 0; k < kLeafCopies; ++k) {
-        n += leaf_samples[size_t(k) * leaves + l];
-        fx += leaf_loss_fx[size_t(k) * leaves + l];
-    }
-    leaf_samples[l] = n;
-    leaf_loss_fx[l] = fx;
-}
-
-// MLP gradient = sum of the per-block slices in block order (deterministic), checked for finiteness
-// (blocks [0, reduce_blocks)); the fast mode's fp16 grid gradient (fine levels, [first, n), 8 values per
-// thread) checked too, as fp16 sums can overflow (the other blocks). One launch for both.
-__global__ void k_reduce_check(const float* slices, int slice_count, float* grad, uint32_t reduce_blocks,
-                               const __half* grad_h, uint32_t first, uint32_t n, uint32_t* flag) {
-    if (blockIdx.x < reduce_blocks) {
-        const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-        if (i >= NB_MLP_WEIGHT_COUNT) return;
-        float s = 0.0f;
-        for (int k = 0; k < slice_count; ++k) s += slices[size_t(k) * NB_MLP_WEIGHT_COUNT + i];
-        grad[i] = s;
-        if (!isfinite(s)) atomicOr(flag, NB_GUARD_GRADIENT);
-        return;
-    }
-    const uint32_t i = first + 8u * ((blockIdx.x - reduce_blocks) * blockDim.x + threadIdx.x);
-    if (i >= n) return;
-    const uint4 q = *reinterpret_cast<const uint4*>(grad_h + i); // first, n: multiples of 8
-    // An fp16 value is inf or NaN exactly when its exponent bits are all set.
-    bool bad = false;
-    for (const uint32_t w : {q.x, q.y, q.z, q.w})
-        bad = bad || (w & 0x7C00u) == 0x7C00u || (w & 0x7C000000u) == 0x7C000000u;
-    if (bad) atomicOr(flag, NB_GUARD_GRADIENT);
-}
-
-// Grid gradient of the deterministic mode: converts the fixed-point sums and checks them (the fast mode's
-// are guarded by the grid backward kernels and k_reduce_check, see step()).
-__global__ void k_check_grid(float* grad, const unsigned long long* fx, uint32_t n, uint32_t* flag) {
-    const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= n) return;
-    const float g = float(double((long long)fx[i]) * (1.0 / double(NB_CUDA_FIXED_SCALE)));
-    grad[i] = g;
-    if (!isfinite(g)) atomicOr(flag, NB_GUARD_GRADIENT);
-}
-
-// Adam's bias-correction factors for per-parameter steps t < kAdamBiasTable, computed once by the same
-// functions k_adam would call (so the same values): nb_adam_update reads them instead of two powf per
-// parameter; a t beyond the table computes them.
-constexpr uint32_t kAdamBiasTable = 1u << 16;
-__global__ void k_adam_bias_tables(float beta1, float beta2, float* bias_sqrt, float* bias_div) {
-    const uint32_t t = blockIdx.x * blockDim.x + threadIdx.x;
-    if (t >= kAdamBiasTable) return;
-    bias_sqrt[t] = nb_adam_bias_sqrt(beta2, t);
-    bias_div[t] = nb_adam_bias_div(beta1, t);
-}
-
-// One parameter group of an Adam launch (the MLP's or the grid's). The gradient of parameter i is
-// grad[i] below `split`, grad_h[i] (fp16) from it on; split and n are multiples of 4.
-struct AdamGroup {
-    float *w, *m, *v;
-    uint32_t* t;
-    __half* wh;
-    const float* grad;
-    const __half* grad_h;
-    uint32_t split, n;
-    GpuAdamRule r;
-};
-
-// Parameters 4q .. 4q + 3 of group g: nb_adam_update of engine/neural/shared/adam_update.h, the CPU's
-// update, on the batch-mean gradient (summed gradient x scale), then the fp16 copy. 16-byte accesses;
-// the gradient is read first, so a quad whose gradients are all 0 (skipped grid entries) reads nothing
-// else. A quad with some skipped parameters writes their unchanged values back.
-__device__ inline void adam_quad(const AdamGroup& g, uint32_t q, float scale, const float* bias_sqrt,
-                                 const float* bias_div) {
-    const uint32_t i = 4u * q;
-    if (i >= g.n) return;
-    float gr[4];
-    if (i < g.split) {
-        const float4 x = *reinterpret_cast<const float4*>(g.grad + i);
-        gr[0] = x.x;
-        gr[1] = x.y;
-        gr[2] = x.z;
-        gr[3] = x.w;
-    } else {
-        const uint2 x = *reinterpret_cast<const uint2*>(g.grad_h + i);
-        const float2 lo = __half22float2(*reinterpret_cast<const __half2*>(&x.x));
-        const float2 hi = __half22float2(*reinterpret_cast<const __half2*>(&x.y));
-        gr[0] = lo.x;
-        gr[1] = lo.y;
-        gr[2] = hi.x;
-        gr[3] = hi.y;
-    }
-    if (g.r.skip_zero != 0u && gr[0] == 0.0f && gr[1] == 0.0f && gr[2] == 0.0f && gr[3] == 0.0f) return;
-    float4 w = *reinterpret_cast<const float4*>(g.w + i);
-    float4 m = *reinterpret_cast<const float4*>(g.m + i);
-    float4 v = *reinterpret_cast<const float4*>(g.v + i);
-    uint4 t = *reinterpret_cast<const uint4*>(g.t + i);
-    float* pw[4] = {&w.x, &w.y, &w.z, &w.w};
-    float* pm[4] = {&m.x, &m.y, &m.z, &m.w};
-    float* pv[4] = {&v.x, &v.y, &v.z, &v.w};
-    uint32_t* pt[4] = {&t.x, &t.y, &t.z, &t.w};
-#pragma unroll
-    for (int k = 0; k < 4; ++k)
-        nb_adam_update(*pw[k], *pm[k], *pv[k], *pt[k], gr[k] * scale, g.r, bias_sqrt, bias_div,
-                       kAdamBiasTable);
-    *reinterpret_cast<float4*>(g.w + i) = w;
-    *reinterpret_cast<float4*>(g.m + i) = m;
-    *reinterpret_cast<float4*>(g.v + i) = v;
-    *reinterpret_cast<uint4*>(g.t + i) = t;
-    const __half2 h0 = __floats2half2_rn(w.x, w.y), h1 = __floats2half2_rn(w.z, w.w);
-    uint2 h;
-    h.x = *reinterpret_cast<const uint32_t*>(&h0);
-    h.y = *reinterpret_cast<const uint32_t*>(&h1);
-    *reinterpret_cast<uint2*>(g.wh + i) = h;
-}
-
-// tcnn Adam over both parameter groups in one launch (blocks [0, a_blocks) group a, the rest group b),
-// per-parameter step counters and the sparse skip of zero grid gradients (adam_update.h), on the summed
-// gradient / (loss scale x trained samples). Does nothing when the guard flag is set or no sample was
-// trained.
-constexpr uint32_t kAdamThreads = 256;
-__global__ void __launch_bounds__(kAdamThreads)
-    k_adam(AdamGroup a, AdamGroup b, uint32_t a_blocks, float scale_inv, const float* bias_sqrt,
-           const float* bias_div, const uint32_t* flag, const uint32_t* valid) {
-    if (*flag != 0u || *valid == 0u) return;
-    const float scale = scale_inv / float(*valid);
-    if (blockIdx.x < a_blocks)
-        adam_quad(a, blockIdx.x * kAdamThreads + threadIdx.x, scale, bias_sqrt, bias_div);
-    else
-        adam_quad(b, (blockIdx.x - a_blocks) * kAdamThreads + threadIdx.x, scale, bias_sqrt, bias_div);
-}
-uint32_t adam_blocks(uint32_t n) { return (n / 4u + kAdamThreads - 1u) / kAdamThreads; }
-static_assert(NB_MLP_WEIGHT_COUNT % 4u == 0u, "k_adam takes the MLP's parameters four at a time");
 
 // One batch of training samples (sampling + ground truth output) with the per-draw counters of its
 // sampling pass. Two slots: the step trains one while the next step's batch is drawn into the other.
@@ -309,8 +133,8 @@ public:
         mlp_t_.alloc(NB_MLP_WEIGHT_COUNT); mlp_t_.zero_async(NB_MLP_WEIGHT_COUNT, stream_);
         grid_h_.alloc(grid_n_);
         mlp_h_.alloc(NB_MLP_WEIGHT_COUNT);
-        k_to_half<<<(grid_n_ + 255) / 256, 256, 0, stream_>>>(grid_w_.p, grid_h_.p, grid_n_);
-        k_to_half<<<(NB_MLP_WEIGHT_COUNT + 255) / 256, 256, 0, stream_>>>(mlp_w_.p, mlp_h_.p, NB_MLP_WEIGHT_COUNT);
+        launch_to_half(grid_w_.p, grid_h_.p, grid_n_, stream_);
+        launch_to_half(mlp_w_.p, mlp_h_.p, NB_MLP_WEIGHT_COUNT, stream_);
         NBVH_CUDA_CHECK(cudaGetLastError());
         if (c.deterministic) { grid_grad_fx_.alloc(grid_n_); grid_grad_fx_.zero_async(grid_n_, stream_); }
         mlp_grad_.alloc(NB_MLP_WEIGHT_COUNT);
@@ -331,8 +155,7 @@ public:
         flag_.alloc(1);
         bias_sqrt_.alloc(kAdamBiasTable);
         bias_div_.alloc(kAdamBiasTable);
-        k_adam_bias_tables<<<kAdamBiasTable / 256, 256, 0, stream_>>>(c.beta1, c.beta2, bias_sqrt_.p,
-                                                                      bias_div_.p);
+        launch_adam_bias_tables(c.beta1, c.beta2, bias_sqrt_.p, bias_div_.p, stream_);
         NBVH_CUDA_CHECK(cudaGetLastError());
         NBVH_CUDA_CHECK(cudaStreamSynchronize(stream_));
     }
@@ -426,13 +249,9 @@ public:
         }
         launch_grid_backward(net_, batch, cfg_.deterministic, flag, s);
         record(5);
-        const int sblocks = int((n + kStatsThreads - 1) / kStatsThreads);
+        const int sblocks = stats_blocks(n);
         partials_.alloc(size_t(sblocks) * 6);
-        k_stats<<<sblocks, kStatsThreads, 0, s>>>(batch, leaves_, leaf_samples_.p, leaf_loss_fx_.p,
-                                                  partials_.p);
-        if (leaves_ > 0)
-            k_fold_leaf_stats<<<(leaves_ + 255) / 256, 256, 0, s>>>(leaves_, leaf_samples_.p,
-                                                                    leaf_loss_fx_.p);
+        launch_stats(batch, leaves_, leaf_samples_.p, leaf_loss_fx_.p, partials_.p, s);
         // The deterministic sums are converted (and checked) by k_check_grid. In the fast mode the coarse
         // levels' fp32 sums need no pass: both grid backward kernels raise the guard on a non-finite
         // dL/dfeature, k_grid_backward_coarse on a block's fp16 partial that overflowed, and the fp32 sum of
@@ -440,12 +259,9 @@ public:
         // k_mlp's wmma, |x| <= 64 x 65504^2 = 2.7e11, and an entry takes at most 24 weighted (w <= 1) adds
         // per sample: below FLT_MAX for any batch below 5e25); the fine levels' fp16 sums can overflow and
         // are checked by k_reduce_check, which also sums the MLP gradient's slices.
-        const uint32_t reduce_blocks = (NB_MLP_WEIGHT_COUNT + 255) / 256;
-        const uint32_t fine = cfg_.deterministic ? 0u : grid_n_ - split_.values;
-        k_reduce_check<<<reduce_blocks + (fine / 8u + 255u) / 256u, 256, 0, s>>>(
-            slices_.p, blocks, mlp_grad_.p, reduce_blocks, grid_grad_h_.p, split_.values, grid_n_, flag);
-        if (cfg_.deterministic)
-            k_check_grid<<<(grid_n_ + 255) / 256, 256, 0, s>>>(grid_grad_.p, grid_grad_fx_.p, grid_n_, flag);
+        launch_reduce_check(slices_.p, blocks, mlp_grad_.p, grid_grad_h_.p, split_.values,
+                            cfg_.deterministic ? split_.values : grid_n_, flag, s);
+        if (cfg_.deterministic) launch_check_grid(grid_grad_.p, grid_grad_fx_.p, grid_n_, flag, s);
         const GpuAdamRule mlp_rule{in.learning_rate, cfg_.beta1, cfg_.beta2, cfg_.epsilon, cfg_.l2_reg, 0u};
         const GpuAdamRule grid_rule{in.learning_rate, cfg_.beta1, cfg_.beta2, cfg_.epsilon, cfg_.non_matrix_l2_reg,
                                     cfg_.skip_zero_grad_non_matrix ? 1u : 0u};
@@ -461,10 +277,7 @@ public:
                             mlp_rule};
         const AdamGroup grid{grid_w_.p,    grid_m_.p,      grid_v_.p,    grid_t_.p, grid_h_.p,
                              grid_grad_.p, grid_grad_h_.p, grid_split(), grid_n_,   grid_rule};
-        const uint32_t mlp_blocks = adam_blocks(NB_MLP_WEIGHT_COUNT);
-        k_adam<<<mlp_blocks + adam_blocks(grid_n_), kAdamThreads, 0, s>>>(
-            mlp, grid, mlp_blocks, 1.0f / scale_, bias_sqrt_.p, bias_div_.p, flag, valid);
-        NBVH_CUDA_CHECK(cudaGetLastError());
+        launch_adam(mlp, grid, 1.0f / scale_, bias_sqrt_.p, bias_div_.p, flag, valid, s);
         record(6);
 
         // Read back (one sync).
