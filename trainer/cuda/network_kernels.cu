@@ -526,7 +526,7 @@ k_mlp(DevNetwork net, DevBatch b, LossParams lp, float* slices, uint32_t* flag) 
         __syncthreads(); // before the next tile overwrites the buffers
     }
     // The block's slice of the MLP gradient (summed over blocks in block order by k_reduce_check,
-    // cuda_core.cu; every value written).
+    // update_kernels.cu; every value written).
     store_weight_grad<3>(slice + nb_mlp_layer_offset(0), NB_MLP_INPUTS, tr, tc0_in, g0);
     store_weight_grad<2>(slice + nb_mlp_layer_offset(1), NB_MLP_WIDTH, tr, tc0_h, g1);
     store_weight_grad<2>(slice + nb_mlp_layer_offset(2), NB_MLP_WIDTH, tr, tc0_h, g2);

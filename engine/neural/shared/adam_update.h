@@ -1,6 +1,6 @@
 // The per-parameter Adam update with tiny-cuda-nn semantics (notes tiny-cuda-nn §C.2, official notes §5),
 // defined once for the CPU trainer (engine/neural/adam.cpp) and the CUDA trainer (k_adam,
-// trainer/cuda/cuda_core.cu). C++ and CUDA only (pointers; GLSL never trains), written in the
+// trainer/cuda/update_kernels.cu). C++ and CUDA only (pointers; GLSL never trains), written in the
 // shaders/shared/compat.h style: NB_FN is `__host__ __device__ inline` under nvcc.
 //
 //   g    : the gradient of the parameter, ALREADY divided by the loss scale (and the batch size where
