@@ -156,7 +156,6 @@ public:
         bias_sqrt_.alloc(kAdamBiasTable);
         bias_div_.alloc(kAdamBiasTable);
         launch_adam_bias_tables(c.beta1, c.beta2, bias_sqrt_.p, bias_div_.p, stream_);
-        NBVH_CUDA_CHECK(cudaGetLastError());
         NBVH_CUDA_CHECK(cudaStreamSynchronize(stream_));
     }
     ~CoreImpl() override {
