@@ -37,13 +37,12 @@ size_t count_mismatches(const std::vector<float>& gpu, const std::vector<float>&
 }
 
 void expect_adam_matches_host(bool deterministic) {
-    Scene scene = test::scene_of(test::height_field(32, 0.2f, 1.0f, glm::vec3(0.0f)));
-    const TrainingAsset asset = make_training_asset(scene, 0);
-    TrainingCut cut = test::cut_at_depth(asset, 5);
+    const test::MeshAsset m(test::height_field(32, 0.2f, 1.0f, glm::vec3(0.0f)));
+    TrainingCut cut = test::cut_at_depth(m.asset, 5);
     CudaBackendOptions opt;
     opt.deterministic = deterministic;
     neural::AdamConfig adam; // tcnn's defaults (lr 1e-2), skip of zero grid gradients on
-    auto gpu = make_cuda_backend_ex(asset, NeuralConfig{.log2_hash_size = 12}, adam, opt, 3);
+    auto gpu = make_cuda_backend_ex(m.asset, NeuralConfig{.log2_hash_size = 12}, adam, opt, 3);
     neural::NetworkWeights host;
     gpu->read_weights(host);
     neural::AdamConfig host_cfg = adam;

@@ -246,8 +246,8 @@ TEST(CudaBackend, NormalMapGroundTruthMatchesTheCpu) {
 
 TEST(CudaBackend, DeterministicModeIsBitReproducible) {
     REQUIRE_GPU();
-    const Scene scene = test::scene_of(test::height_field(32, 0.2f, 1.0f, glm::vec3(0.0f)));
-    const TrainingAsset asset = make_training_asset(scene, 0);
+    const test::MeshAsset m(test::height_field(32, 0.2f, 1.0f, glm::vec3(0.0f)));
+    const TrainingAsset& asset = m.asset;
     TrainingCut cut = cut_at_depth(asset, 5);
     CudaBackendOptions opt;
     opt.deterministic = true;
@@ -336,12 +336,11 @@ uint32_t run_guarded_steps(CudaTrainerBackend& b, const TrainingCut& cut, uint32
 
 TEST(CudaBackend, HugeLearningRateIsCaughtByTheGuard) {
     REQUIRE_GPU();
-    const Scene scene = test::scene_of(test::cube());
-    const TrainingAsset asset = make_training_asset(scene, 0);
-    TrainingCut cut = cut_at_depth(asset, 3);
+    const test::MeshAsset m(test::cube());
+    TrainingCut cut = cut_at_depth(m.asset, 3);
     neural::AdamConfig adam;
     adam.learning_rate = 1e30f;
-    auto b = make_cuda_backend_ex(asset, NeuralConfig{.log2_hash_size = 10}, adam, CudaBackendOptions{}, 1);
+    auto b = make_cuda_backend_ex(m.asset, NeuralConfig{.log2_hash_size = 10}, adam, CudaBackendOptions{}, 1);
     // The first step blows the fp16 weights up; later steps are refused.
     EXPECT_GE(run_guarded_steps(*b, cut, 5, 1024, 1, "non-finite"), 1u);
 }
@@ -351,12 +350,11 @@ TEST(CudaBackend, HugeLearningRateIsCaughtByTheGuard) {
 // reaches the weights.
 TEST(CudaBackend, OverflowingLossScaleIsHalvedByTheGuard) {
     REQUIRE_GPU();
-    const Scene scene = test::scene_of(test::height_field(16, 0.2f, 1.0f, glm::vec3(0.0f)));
-    const TrainingAsset asset = make_training_asset(scene, 0);
-    TrainingCut cut = cut_at_depth(asset, 4);
+    const test::MeshAsset m(test::height_field(16, 0.2f, 1.0f, glm::vec3(0.0f)));
+    TrainingCut cut = cut_at_depth(m.asset, 4);
     CudaBackendOptions opt;
     opt.loss_scale = 65536.0f;
-    auto b = make_cuda_backend_ex(asset, NeuralConfig{.log2_hash_size = 12}, neural::AdamConfig{}, opt, 3);
+    auto b = make_cuda_backend_ex(m.asset, NeuralConfig{.log2_hash_size = 12}, neural::AdamConfig{}, opt, 3);
     const uint32_t skipped = run_guarded_steps(*b, cut, 24, 4096, 3, "non-finite gradient");
     EXPECT_GE(skipped, 1u);
     EXPECT_LT(skipped, 24u);
@@ -373,12 +371,11 @@ TEST(CudaBackend, OverflowingFp16GridGradientsAreGuarded) {
     Mesh quad;
     test::add_quad(quad, {0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f},
                    {0, 0, 1});
-    const Scene scene = test::scene_of(std::move(quad));
-    const TrainingAsset asset = make_training_asset(scene, 0);
-    TrainingCut cut = cut_at_depth(asset, 0);
+    const test::MeshAsset m(std::move(quad));
+    TrainingCut cut = cut_at_depth(m.asset, 0);
     CudaBackendOptions opt;
     opt.loss_scale = 16384.0f;
-    auto b = make_cuda_backend_ex(asset, NeuralConfig{.log2_hash_size = 14}, neural::AdamConfig{}, opt, 5);
+    auto b = make_cuda_backend_ex(m.asset, NeuralConfig{.log2_hash_size = 14}, neural::AdamConfig{}, opt, 5);
     const uint32_t skipped = run_guarded_steps(*b, cut, 6, 65536, 5, "non-finite gradient");
     std::printf("fp16 grid gradients at loss scale 16384: %u of 6 steps skipped, scale now %.0f\n", skipped,
                 b->loss_scale());

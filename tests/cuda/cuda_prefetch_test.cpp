@@ -71,15 +71,15 @@ void expect_same_runs(const StepRun& with, const StepRun& without, const std::ve
     EXPECT_EQ(with.weights.grid, without.weights.grid);
 }
 
-TrainingAsset height_field_asset(Scene& scene) {
-    scene = test::scene_of(test::height_field(32, 0.2f, 1.0f, glm::vec3(0.0f)));
-    return make_training_asset(scene, 0);
-}
+// The prefetch tests' asset: a 32 x 32 height field.
+struct HeightField : test::MeshAsset {
+    HeightField() : test::MeshAsset(test::height_field(32, 0.2f, 1.0f, glm::vec3(0.0f))) {}
+};
 
 TEST(CudaPrefetch, SameRaysAndWeightsAsWithoutPrefetch) {
     REQUIRE_GPU();
-    Scene scene;
-    const TrainingAsset asset = height_field_asset(scene);
+    const HeightField h;
+    const TrainingAsset& asset = h.asset;
     TrainingCut cut = test::cut_at_depth(asset, 5);
     for (size_t i = 0; i < cut.size(); ++i) cut.keep_probability[i] = i % 3 == 0 ? 0.25f : 1.0f; // roulette redraws
     const std::vector<StepInput> steps(5, StepInput{&cut, 1});
@@ -99,8 +99,8 @@ TEST(CudaPrefetch, SameRaysAndWeightsAsWithoutPrefetch) {
 
 TEST(CudaPrefetch, CutChangeDropsTheBatchDrawnAhead) {
     REQUIRE_GPU();
-    Scene scene;
-    const TrainingAsset asset = height_field_asset(scene);
+    const HeightField h;
+    const TrainingAsset& asset = h.asset;
     const TrainingCut coarse = test::cut_at_depth(asset, 3), fine = test::cut_at_depth(asset, 6);
     ASSERT_NE(coarse.size(), fine.size());
     const std::vector<StepInput> steps{{&coarse, 1}, {&fine, 2}, {&fine, 2}, {&coarse, 3}};
@@ -111,8 +111,8 @@ TEST(CudaPrefetch, CutChangeDropsTheBatchDrawnAhead) {
 // that repeats or skips a step index, or changes the batch or the seed, gets a batch drawn anew.
 TEST(CudaPrefetch, OtherStepBatchOrSeedDrawsAnew) {
     REQUIRE_GPU();
-    Scene scene;
-    const TrainingAsset asset = height_field_asset(scene);
+    const HeightField h;
+    const TrainingAsset& asset = h.asset;
     TrainingCut cut = test::cut_at_depth(asset, 5);
     for (size_t i = 0; i < cut.size(); ++i) cut.keep_probability[i] = i % 4 == 0 ? 0.3f : 1.0f;
     auto in = [&](uint32_t step, uint32_t batch, uint64_t seed) { return StepInput{&cut, 1, step, batch, seed}; };
@@ -125,8 +125,8 @@ TEST(CudaPrefetch, OtherStepBatchOrSeedDrawsAnew) {
 // passed at step k+1 shapes the rays of step k+2.
 TEST(CudaPrefetch, NewKeepProbabilitiesActOneStepLater) {
     REQUIRE_GPU();
-    Scene scene;
-    const TrainingAsset asset = height_field_asset(scene);
+    const HeightField h;
+    const TrainingAsset& asset = h.asset;
     TrainingCut all = test::cut_at_depth(asset, 5), few = all;
     for (size_t i = 0; i < few.size(); ++i) few.keep_probability[i] = i % 2 == 0 ? 0.05f : 1.0f;
     // A keep change is not a cut change: same cut_version.
