@@ -18,6 +18,19 @@ __device__ inline InvDir inv_dir(vec3 d) {
     return r;
 }
 
+// One slab's [ta, tb] (ta <= tb) narrowing [t0, t1], and the clip's result: a hit when the interval is a
+// finite, non-empty one (clip_line_to_box's last steps).
+__device__ inline void clip_narrow(float ta, float tb, float& t0, float& t1) {
+    t0 = ta > t0 ? ta : t0;
+    t1 = tb < t1 ? tb : t1;
+}
+__device__ inline bool clip_result(float t0, float t1, float& t_entry, float& t_exit) {
+    if (!(t0 <= t1) || !isfinite(t0) || !isfinite(t1)) return false;
+    t_entry = t0;
+    t_exit = t1;
+    return true;
+}
+
 // trainer/training_rays.cpp clip_line_to_box on a box dilated as dilate_box() (same float operations),
 // the box given by its centre and half extent (cut_tree.h box_centre_half, computed once per node on
 // the host: dilate_box's first steps, the same values). A negative half extent is an empty box.
@@ -39,13 +52,9 @@ __device__ inline bool clip_dilated(const float centre[3], const float half_exte
         const float inv = id.v[a];
         float ta = (lo - oa) * inv, tb = (hi - oa) * inv;
         if (ta > tb) { const float t = ta; ta = tb; tb = t; }
-        t0 = ta > t0 ? ta : t0;
-        t1 = tb < t1 ? tb : t1;
+        clip_narrow(ta, tb, t0, t1);
     }
-    if (!(t0 <= t1) || !isfinite(t0) || !isfinite(t1)) return false;
-    t_entry = t0;
-    t_exit = t1;
-    return true;
+    return clip_result(t0, t1, t_entry, t_exit);
 }
 
 // The same clip for the common case, without its branches: a box the cut tree keeps (cut_tree.h
@@ -60,9 +69,7 @@ __device__ inline bool clip_dilated(const float centre[3], const float half_exte
 // opposite sign, clip_dilated keeps them unswapped and this clip reverses them, so a hit there has entry and
 // exit (+0, -0) against (-0, +0). Such a hit has t_exit = 0, which the first-leaf walk rejects (t_exit <=
 // min_exit, min_exit > 0: training_asset.cpp), so the walk's results are the same. About half the
-// instructions per box (the first-leaf walk clips two child boxes per node). Its last lines repeat
-// clip_dilated's on purpose: moving them into shared inline helpers changed k_sample's code (28,544 ->
-// 28,672 bytes of SASS), which was not measured.
+// instructions per box (the first-leaf walk clips two child boxes per node).
 struct SlabRay {
     float o[3], inv[3], gs[3];
 };
@@ -88,13 +95,9 @@ __device__ inline bool clip_regular(const float centre[3], const float half_exte
         const float sh = half_extent[a] * r.gs[a];
         const float ta = ((centre[a] - sh) - r.o[a]) * r.inv[a];
         const float tb = ((centre[a] + sh) - r.o[a]) * r.inv[a];
-        t0 = ta > t0 ? ta : t0;
-        t1 = tb < t1 ? tb : t1;
+        clip_narrow(ta, tb, t0, t1);
     }
-    if (!(t0 <= t1) || !isfinite(t0) || !isfinite(t1)) return false;
-    t_entry = t0;
-    t_exit = t1;
-    return true;
+    return clip_result(t0, t1, t_entry, t_exit);
 }
 
 } // namespace nbvh::cuda
