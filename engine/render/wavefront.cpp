@@ -444,7 +444,6 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
     // (each adds less than 2^32, wave_plan.h counter_safe_paths) and the wrapped differences summed in 64
     // bits. [0..6]: primary, secondary, shadow rays, non-finite samples, neural queries, rounds, leaf-cap
     // rays; then path rays, shadow rays and neural queries per bounce (NB_STAT_DEPTHS each).
-    static_assert(NB_NL_STAT_DEPTHS == NB_STAT_DEPTHS, "per-bounce statistics");
     constexpr size_t N = 7 + 3 * NB_STAT_DEPTHS;
     uint64_t totals[N] = {};
     uint64_t last[N] = {};

@@ -12,7 +12,7 @@ void main() {
     counters.pending_count = 0u;
     neural_counters.pending_active = n;
     nb_add_u64(neural_counters.queries_total, neural_counters.queries_total_hi, n);
-    neural_counters.queries_by_depth[min(pc.depth, NB_NL_STAT_DEPTHS - 1u)] += n;
+    neural_counters.queries_by_depth[min(pc.depth, NB_STAT_DEPTHS - 1u)] += n;
     if (n > 0u) neural_counters.rounds += 1u;
     counters.pending_dispatch.x = (n + NB_NEURAL_GROUP - 1u) / NB_NEURAL_GROUP;
     counters.pending_dispatch.y = 1u;

@@ -77,7 +77,7 @@ void main() {
         st.rounds += 1u;
         // The next query (the first ones were counted by neural_args); the one that wraps carries.
         if (atomicAdd(neural_counters.queries_total, 1u) == 0xFFFFFFFFu) atomicAdd(neural_counters.queries_total_hi, 1u);
-        atomicAdd(neural_counters.queries_by_depth[min(pc.depth, NB_NL_STAT_DEPTHS - 1u)], 1u);
+        atomicAdd(neural_counters.queries_by_depth[min(pc.depth, NB_STAT_DEPTHS - 1u)], 1u);
         r.pl.instance = g_nl_cand_inst[0];
         r.pl.leaf = g_nl_cand_leaf[0];
         r.pl.t_enter = g_nl_cand_entry[0];

@@ -9,8 +9,9 @@
 #ifndef NB_NEURAL_GPU_H
 #define NB_NEURAL_GPU_H
 #include "compat.h"
-#include "neural_query.h"
 #include "intersect.h"
+#include "neural_query.h"
+#include "wavefront_gpu.h" // NB_STAT_DEPTHS
 
 // Threads per workgroup of the query kernels. The cooperative-matrix kernel maps one subgroup of 32
 // (checked on the host: it is only built on devices whose subgroup size is 32) to 32 queries.
@@ -195,7 +196,6 @@ NB_FN vec2 nb_node_fit_spread(vec2 fit, vec2 spread, uint random_bits) {
     return fit + s * spread;
 }
 
-#define NB_NL_STAT_DEPTHS 16u // = NB_STAT_DEPTHS (wavefront_gpu.h; checked in wavefront.cpp)
 struct GpuNeuralCounters {
     uint pending_active;  // pairs the current neural_query dispatch processes
     uint queries_total;   // statistics: queries of the render (path and shadow rays), low 32 bits
@@ -210,12 +210,12 @@ struct GpuNeuralCounters {
     uint pad1;
     uint pad2;
     // Statistics: queries per bounce of the path (index = depth, the last bucket also counting deeper
-    // ones; NB_NL_STAT_DEPTHS = wavefront_gpu.h NB_STAT_DEPTHS), 32-bit like the ray counters (read and
+    // ones; as the ray counters of wavefront_gpu.h), 32-bit like the ray counters (read and
     // summed in 64 bits after every submission; a bounce's queries in one submission stay below 2^32:
     // wave_plan.h bounds the leaves queued per wave).
-    uint queries_by_depth[NB_NL_STAT_DEPTHS];
+    uint queries_by_depth[NB_STAT_DEPTHS];
 };
-NB_STATIC_ASSERT(sizeof(GpuNeuralCounters) == 32 + 4 * NB_NL_STAT_DEPTHS, "GpuNeuralCounters layout");
+NB_STATIC_ASSERT(sizeof(GpuNeuralCounters) == 32 + 4 * NB_STAT_DEPTHS, "GpuNeuralCounters layout");
 
 // 64-bit counter (lo, hi) += n in 32-bit words (one writer at a time: passes/neural_args.comp).
 NB_FN void nb_add_u64(NB_INOUT(uint) lo, NB_INOUT(uint) hi, uint n) {
