@@ -35,6 +35,7 @@
 #include "engine/render/wavefront.h"
 #include "engine/scene/camera.h"
 #include "engine/scene/environment.h"
+#include "engine/scene/subdivide.h"
 #include "engine/vk/context.h"
 
 namespace nbvh::app {
@@ -46,6 +47,7 @@ struct RenderArgs {
     std::string model, neural_path = "auto", neural_glob, texture_path = "auto", secondary_lod = "coarsest";
     render::RenderOptions options;
     bool explain = false;
+    uint32_t subdivide = 0;   // flat midpoint subdivision levels of every mesh (engine/scene/subdivide.h)
     std::string command_line; // as typed, written into --stats
 };
 
@@ -63,7 +65,8 @@ nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o
                         {"sort_rays", o.sort_rays},
                         {"sampler", render::sampler_name(o.sampler)},
                         {"max_wave_pixels", o.max_wave_pixels},
-                        {"texture_path", a.texture_path}};
+                        {"texture_path", a.texture_path},
+                        {"subdivide", a.subdivide}};
     if (o.neural.model) {
         const render::NeuralRenderOptions& n = o.neural;
         j["neural"] = {{"model", a.model},
@@ -143,6 +146,7 @@ void run_render(const RenderArgs& a) {
     copt.set_device(a.device);
     SceneLoadOptions lo;
     lo.neural_glob = a.neural_glob;
+    lo.subdivide = a.subdivide;
     render::RenderOptions options = a.options;
     options.texture_path = texture_path;
     options.neural.secondary_lod = secondary_lod;
@@ -235,6 +239,11 @@ void add_render_command(CLI::App& app, const std::string& command_line) {
     cmd->add_flag("--classical", args->options.neural.classical,
                   "reference: the true scene (neural instances from their triangles and glTF materials)");
     cmd->add_option("--neural", args->neural_glob, "nodes whose name matches this glob are neural instances");
+    cmd->add_option(
+           "--subdivide", args->subdivide,
+           "split every triangle into 4, L times: the same surface in 4^L times the triangles (a dense "
+           "asset's classical cost; a model must be trained with the same --subdivide)")
+        ->check(CLI::Range(0u, MAX_SUBDIVISION_LEVELS));
     cmd->add_option("--lod", args->options.neural.lod, "N-BVH level of detail of camera rays (0 = finest)");
     cmd->add_option("--secondary-lod", args->secondary_lod,
                     "N-BVH level of detail after the first hit: coarsest (default: the model's coarsest LoD, "

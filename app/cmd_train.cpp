@@ -19,6 +19,7 @@
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/neural/model_file.h"
+#include "engine/scene/subdivide.h"
 #include "engine/vk/context.h"
 #include "trainer/compact_hash.h"
 #include "trainer/evaluation.h"
@@ -44,6 +45,7 @@ struct TrainArgs {
     // Unset (not given on the command line) = the backend's default.
     std::optional<uint32_t> nodes, hash_log2, steps, batch, lods;
     uint32_t threads = 0;
+    uint32_t subdivide = 0; // flat midpoint subdivision levels of every mesh (engine/scene/subdivide.h)
     uint64_t seed = 1337;
     bool deterministic = false; // CUDA backend: order-independent gradient sums (trainer/cuda/README.md)
 };
@@ -96,7 +98,7 @@ void run_train(const TrainArgs& a) {
     check_output_path(out, "--out", {a.scene});
     check_output_path(a.log_csv, "--log", {a.scene, out});
 
-    const TrainingScene ts = load_training_scene(a.scene, a.neural_glob, a.asset_glob);
+    const TrainingScene ts = load_training_scene(a.scene, a.neural_glob, a.asset_glob, a.subdivide);
     const TrainingAsset asset = make_training_asset(ts.scene, ts.meshes);
     if (!a.hash_log2) { // compact default (trainer/compact_hash.h): the grid <= 1/5 of the geometry
         const uint32_t max_log2 = opt.network.log2_hash_size;
@@ -163,6 +165,11 @@ void add_train_command(CLI::App& app) {
     cmd->add_option("--steps", args->steps, "optimiser steps (CPU default 1000, CUDA 10000)");
     cmd->add_option("--batch", args->batch, "rays per step (CPU default 2048, CUDA 262144)");
     cmd->add_option("--lods", args->lods, "cuts kept as levels of detail (1..8, default 3: render and view trace rays after the first hit on the coarsest)");
+    cmd->add_option(
+           "--subdivide", args->subdivide,
+           "split every triangle into 4, L times: the same surface in 4^L times the triangles (a dense "
+           "asset's classical cost; render the model with the same --subdivide)")
+        ->check(CLI::Range(0u, MAX_SUBDIVISION_LEVELS));
     cmd->add_option("--seed", args->seed, "random seed (network init and rays)");
     cmd->add_option("--threads", args->threads, "CPU backend threads (default: all cores)");
     cmd->add_flag("--deterministic", args->deterministic, "CUDA backend: bit-reproducible steps (slower)");

@@ -3,12 +3,14 @@
 #include "assets/default_scene.h"
 #include "engine/core/log.h"
 #include "engine/neural/asset_table.h"
+#include "engine/scene/subdivide.h"
 
 namespace nbvh::app {
 
 Scene load_scene_arg(const std::string& arg, const SceneLoadOptions& options) {
     if (arg == "default") {
         Scene scene = assets::make_default_scene();
+        subdivide_scene(scene, options.subdivide);
         if (!options.neural_glob.empty()) mark_neural_by_glob(scene, options.neural_glob);
         return scene;
     }

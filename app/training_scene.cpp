@@ -7,16 +7,18 @@
 #include "engine/neural/model_file.h"
 #include "engine/scene/gltf_loader.h"
 #include "engine/scene/scene_stats.h"
+#include "engine/scene/subdivide.h"
 #include "trainer/training_asset.h"
 
 namespace nbvh::app {
 
 TrainingScene load_training_scene(const std::string& scene_arg, const std::string& neural_glob,
-                                  const std::string& asset_glob) {
+                                  const std::string& asset_glob, uint32_t subdivide) {
     TrainingScene t;
     Scene& scene = t.scene;
     if (scene_arg == "default") {
         scene = assets::make_default_scene();
+        subdivide_scene(scene, subdivide);
         if (!neural_glob.empty()) mark_neural_by_glob(scene, neural_glob);
         // The built-in scene has no file to hash: hash its geometry, so the model still names its source.
         t.source_hash = FNV1A64_OFFSET;
@@ -29,6 +31,7 @@ TrainingScene load_training_scene(const std::string& scene_arg, const std::strin
         SceneLoadOptions lo;
         lo.neural_glob = neural_glob;
         lo.require_geometry = true;
+        lo.subdivide = subdivide;
         scene = load_gltf(scene_arg, lo);
         t.source_hash = fnv1a64_file(scene_arg);
     }

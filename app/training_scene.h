@@ -16,9 +16,11 @@ struct TrainingScene {
     std::vector<uint32_t> meshes; // the neural meshes (assets) to learn, indices into scene.meshes
 };
 
+// `subdivide`: flat midpoint subdivision levels of every mesh (engine/scene/subdivide.h), before the
+// assets are cut; a render of the model must load the scene with the same levels.
 // Throws nbvh::Error for a --neural glob that matches no node, an --asset glob that matches no asset, or a
 // scene without a neural asset.
 TrainingScene load_training_scene(const std::string& scene_arg, const std::string& neural_glob,
-                                  const std::string& asset_glob);
+                                  const std::string& asset_glob, uint32_t subdivide = 0);
 
 } // namespace nbvh::app

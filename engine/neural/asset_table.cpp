@@ -244,9 +244,10 @@ std::vector<int32_t> bind_model_to_scene(Scene& scene, const NeuralModel& model,
         const ModelAsset& a = model.assets[size_t(it->second)];
         const uint32_t mat = mesh.triangle_material.empty() ? 0u : mesh.triangle_material[0];
         if (a.geometry_hash != 0 && a.geometry_hash != geometry_fingerprint(mesh))
-            throw Error(strfmt("%s does not match the scene: asset '%s' has different geometry (the mesh changed "
-                               "since training; retrain with nbvh train)",
-                               model_name.c_str(), a.name.c_str()));
+            throw Error(
+                strfmt("%s does not match the scene: asset '%s' has different geometry (the mesh changed "
+                       "since training, or --subdivide differs; retrain with nbvh train)",
+                       model_name.c_str(), a.name.c_str()));
         if (a.material_hash != 0 && a.material_hash != material_fingerprint(scene, mat))
             throw Error(strfmt("%s does not match the scene: asset '%s' has a different base colour (the material "
                                "changed since training; retrain with nbvh train)",

@@ -22,6 +22,7 @@
 #include "engine/scene/gltf_support.h"
 #include "engine/scene/mesh_builder.h"
 #include "engine/scene/scene_stats.h"
+#include "engine/scene/subdivide.h"
 
 namespace nbvh {
 namespace {
@@ -506,6 +507,7 @@ private:
                     throw Error(strfmt("%s: coordinates out of range: world bounds reach beyond %g after node transforms",
                                        path_.string().c_str(), double(MAX_WORLD_COORDINATE)));
         }
+        subdivide_scene(scene_, options_.subdivide);
         const SceneStats stats = scene_stats(scene_);
         if (stats.instanced_triangles == 0) {
             if (options_.require_geometry)

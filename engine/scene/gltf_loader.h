@@ -28,6 +28,10 @@ struct SceneLoadOptions {
     bool keep_textures = true;
     // Throw nbvh::Error "no renderable geometry" instead of returning a scene without triangles.
     bool require_geometry = false;
+    // Flat midpoint subdivision levels applied to every mesh after loading (engine/scene/subdivide.h):
+    // the same surface in 4^subdivide times the triangles. The built-in default scene takes it from the
+    // app's loaders (app/scene_arg.h).
+    uint32_t subdivide = 0;
 };
 
 Scene load_gltf(const std::filesystem::path& path, const SceneLoadOptions& options = {});

@@ -205,8 +205,9 @@ std::vector<std::string> tiny_train(const std::string& scene, const fs::path& ou
 TEST(CliTrain, OptionsOutOfRange) {
     const fs::path dir = nbvh::test::temp_dir("cli_train_opts");
     const std::vector<std::pair<std::string, std::string>> cases = {
-        {"--nodes", "0"}, {"--steps", "0"}, {"--batch", "0"}, {"--hash-log2", "99"}, {"--hash-log2", "0"},
-        {"--lods", "0"},  {"--lods", "99"}, {"--backend", "tpu"}, {"--nodes", "-3"}, {"--steps", "x"}};
+        {"--nodes", "0"},     {"--steps", "0"}, {"--batch", "0"},     {"--hash-log2", "99"},
+        {"--hash-log2", "0"}, {"--lods", "0"},  {"--lods", "99"},     {"--backend", "tpu"},
+        {"--nodes", "-3"},    {"--steps", "x"}, {"--subdivide", "5"}, {"--subdivide", "-1"}};
     for (const auto& [opt, val] : cases) {
         SCOPED_TRACE(opt + " " + val);
         std::vector<std::string> a = tiny_train("default", dir / "m.nbvh");
@@ -214,6 +215,27 @@ TEST(CliTrain, OptionsOutOfRange) {
         EXPECT_CLEAN_ERROR(run_nbvh(a, 20.0), opt);
     }
     EXPECT_FALSE(fs::exists(dir / "m.nbvh"));
+}
+
+// --subdivide L: a model trained on the subdivided scene is refused by a render without the same L (one
+// line naming the option), and a level count whose triangles pass the limit fails before any work.
+TEST(CliTrain, SubdivideMustMatchBetweenTrainingAndRender) {
+    const fs::path dir = nbvh::test::temp_dir("cli_train_subdivide");
+    std::vector<std::string> t = tiny_train("default", dir / "m.nbvh");
+    t.insert(t.end(), {"--subdivide", "1", "--lods", "1"});
+    const nbvh::test::RunResult trained = run_nbvh(t, 120.0);
+    ASSERT_EQ(trained.exit_code, 0) << trained.describe();
+    std::vector<std::string> r = tiny_render("default", dir / "o.png");
+    r.insert(r.end(), {"--model", (dir / "m.nbvh").string()});
+    EXPECT_CLEAN_ERROR_AFTER_INFO(run_nbvh(r, 60.0), "--subdivide differs");
+    EXPECT_FALSE(fs::exists(dir / "o.png"));
+    r = tiny_render("default", dir / "o.png");
+    r.insert(r.end(), {"--subdivide", "4"}); // 384k+ triangles x 256 > 2^26
+    EXPECT_CLEAN_ERROR_AFTER_INFO(run_nbvh(r, 20.0), "--subdivide 4", "would become");
+    r = tiny_render("default", dir / "o.png");
+    r.insert(r.end(), {"--subdivide", "9"});
+    EXPECT_CLEAN_ERROR(run_nbvh(r, 20.0), "--subdivide");
+    EXPECT_FALSE(fs::exists(dir / "o.png"));
 }
 
 // --device picks the GPU that CUDA trains on, numbered as every other command's --device (Vulkan, PCI
