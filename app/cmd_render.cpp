@@ -48,6 +48,7 @@ struct RenderArgs {
     render::RenderOptions options;
     bool explain = false;
     uint32_t subdivide = 0;   // flat midpoint subdivision levels of every mesh (engine/scene/subdivide.h)
+    uint32_t warmup = 0;      // untimed renders of the same image before the one written
     std::string command_line; // as typed, written into --stats
 };
 
@@ -66,7 +67,8 @@ nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o
                         {"sampler", render::sampler_name(o.sampler)},
                         {"max_wave_pixels", o.max_wave_pixels},
                         {"texture_path", a.texture_path},
-                        {"subdivide", a.subdivide}};
+                        {"subdivide", a.subdivide},
+                        {"warmup", a.warmup}};
     if (o.neural.model) {
         const render::NeuralRenderOptions& n = o.neural;
         j["neural"] = {{"model", a.model},
@@ -181,6 +183,10 @@ void run_render(const RenderArgs& a) {
     log_info("render: BVHs built in %.1f ms", std::chrono::duration<double, std::milli>(
                                                   std::chrono::steady_clock::now() - t0).count());
     render::WavefrontRenderer renderer(ctx, scene, accel, env, camera, options);
+    // --warmup: the same image rendered first, untimed. A GPU left idle by a long CPU phase (a large
+    // scene's BVH build) starts at low clocks: an H200's 16-spp 1080p frames ran 3-5x slow right after
+    // a 4-17 s build (results/perf/dense/README.md).
+    for (uint32_t i = 0; i < a.warmup; ++i) (void)renderer.render();
     render::RenderResult result = renderer.render();
     const render::RenderStats& s = result.stats;
     log_info("render: %ux%u, %u spp on %s: %.1f ms GPU, %.3g rays/s, %llu non-finite pixels", s.width, s.height,
@@ -239,6 +245,11 @@ void add_render_command(CLI::App& app, const std::string& command_line) {
     cmd->add_flag("--classical", args->options.neural.classical,
                   "reference: the true scene (neural instances from their triangles and glTF materials)");
     cmd->add_option("--neural", args->neural_glob, "nodes whose name matches this glob are neural instances");
+    cmd->add_option(
+           "--warmup", args->warmup,
+           "render the image this many times first, untimed, in the same process (GPU clocks and caches "
+           "settle before the timed render that is written; for benchmarks)")
+        ->check(CLI::Range(0u, 16u));
     cmd->add_option(
            "--subdivide", args->subdivide,
            "split every triangle into 4, L times: the same surface in 4^L times the triangles (a dense "

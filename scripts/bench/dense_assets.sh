@@ -4,8 +4,10 @@
 # the classical side's cost changes, as between a modest mesh and a dense scan of the same shape (the
 # paper's Statuette). One binary, one GPU call. Per scene and level:
 #   - a model trained by `nbvh train --subdivide L` with no other flag (its wall time recorded);
-#   - 1920x1080, SPP (16) spp, max depth 8, render defaults: a warm-up of each side, then classical,
-#     hybrid, classical, hybrid (the fastest of each; GPU timestamps);
+#   - 1920x1080, SPP (16) spp, max depth 8, render defaults: classical, hybrid, classical, hybrid (the
+#     fastest of each; GPU timestamps), each after two untimed renders of the same image in its process
+#     (`--warmup 2`: the GPU idles through a large scene's BVH build and starts the next frame at low
+#     clocks; separate warm-up processes do not help there);
 #   - at FLIP_W x FLIP_H (960x540), FLIP_SPP (2048) spp: a classical reference of seed 7, the classical
 #     render of seed 0 (the noise floor) and the hybrid of seed 0, LDR-FLIP of both against the reference.
 # Usage (GPU machine, after `source .device/env.sh`): SCENES="dragon default" LEVELS="0 1 2" \
@@ -19,7 +21,7 @@ B=${NBVH:-.device/study/bin/nbvh}
 T=${TMPDIR:-/tmp}/nbvh_dense
 mkdir -p "$OUT" "$T"
 (nvidia-smi --query-gpu=name,driver_version --format=csv,noheader || echo "no nvidia-smi") | tee "$OUT/device.txt"
-R=(--width 1920 --height 1080 --max-depth 8 --exposure 0 --spp "${SPP:-16}")
+R=(--width 1920 --height 1080 --max-depth 8 --exposure 0 --spp "${SPP:-16}" --warmup 2)
 F=(--width "${FLIP_W:-960}" --height "${FLIP_H:-540}" --max-depth 8 --exposure 0 --spp "${FLIP_SPP:-2048}")
 for scene in ${SCENES:-dragon default}; do
   bench_scene "$scene" "$T"
@@ -32,8 +34,6 @@ for scene in ${SCENES:-dragon default}; do
     echo "{\"train_wall_s\": $(python3 -c "print($t1 - $t0)")}" > "$P.train.json"
     C=("${SRC[@]}" "${NEURAL[@]}" --classical "${VIEW[@]}" "${D[@]}")
     H=("${SRC[@]}" --model "$P.nbvh" "${VIEW[@]}" "${D[@]}")
-    "$B" render "${C[@]}" "${R[@]}" --out "$T/warm.png" > /dev/null 2>&1
-    "$B" render "${H[@]}" "${R[@]}" --out "$T/warm.png" > /dev/null 2>&1
     for rep in 1 2; do
       "$B" render "${C[@]}" "${R[@]}" --out "$T/c.png" --stats "$P.classical_$rep.json" > /dev/null 2>&1
       "$B" render "${H[@]}" "${R[@]}" --out "$T/h.png" --stats "$P.hybrid_$rep.json" > /dev/null 2>&1

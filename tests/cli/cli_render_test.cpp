@@ -211,4 +211,24 @@ TEST(CliRenderOutput, ExistingImageReplacedOnlyBySuccess) {
     EXPECT_EQ(files, 2) << "temporary files left behind";
 }
 
+// --warmup N renders the image N times first, untimed: the written image is the same as without it
+// (the renderer restarts its samples each render), and --stats records the setting.
+TEST(CliRenderOutput, WarmupRendersTheSameImage) {
+    const fs::path dir = nbvh::test::temp_dir("cli_warmup");
+    auto render = [&](const char* warmup, const std::string& name) {
+        const RunResult r =
+            run_nbvh({"render", "default", "--device", "cpu", "--width", "24", "--height", "16", "--spp", "2",
+                      "--exposure", "0", "--warmup", warmup, "--out", (dir / (name + ".png")).string(),
+                      "--stats", (dir / (name + ".json")).string()});
+        EXPECT_EQ(r.exit_code, 0) << r.describe();
+    };
+    render("0", "cold");
+    render("2", "warm");
+    EXPECT_EQ(read_file(dir / "cold.png"), read_file(dir / "warm.png"));
+    EXPECT_NE(read_file(dir / "warm.json").find("\"warmup\": 2"), std::string::npos);
+    const RunResult bad = run_nbvh(
+        {"render", "default", "--device", "cpu", "--warmup", "99", "--out", (dir / "x.png").string()});
+    EXPECT_EQ(check_clean_error(bad, {"--warmup"}), "") << bad.describe();
+}
+
 } // namespace
