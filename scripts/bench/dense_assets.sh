@@ -12,6 +12,8 @@
 #     render of seed 0 (the noise floor) and the hybrid of seed 0, LDR-FLIP of both against the reference.
 # Usage (GPU machine, after `source .device/env.sh`): SCENES="dragon default" LEVELS="0 1 2" \
 #   scripts/bench/dense_assets.sh OUT     (NBVH: the binary, default .device/study/bin/nbvh)
+# Env also: WIDTH, HEIGHT (1920x1080), TRAIN_ARGS (extra `nbvh train` flags; CI's dry run trains tiny CPU
+# models with them, tests/bench/bench_scripts_dry_run.sh).
 # Writes OUT/dense.json (every row), OUT/train_SCENE_L.log, OUT/device.txt; prints a table.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -21,15 +23,17 @@ B=${NBVH:-.device/study/bin/nbvh}
 T=${TMPDIR:-/tmp}/nbvh_dense
 mkdir -p "$OUT" "$T"
 (nvidia-smi --query-gpu=name,driver_version --format=csv,noheader || echo "no nvidia-smi") | tee "$OUT/device.txt"
-R=(--width 1920 --height 1080 --max-depth 8 --exposure 0 --spp "${SPP:-16}" --warmup 2)
+R=(--width "${WIDTH:-1920}" --height "${HEIGHT:-1080}" --max-depth 8 --exposure 0 --spp "${SPP:-16}" --warmup 2)
 F=(--width "${FLIP_W:-960}" --height "${FLIP_H:-540}" --max-depth 8 --exposure 0 --spp "${FLIP_SPP:-2048}")
+# shellcheck disable=SC2206
+TA=(${TRAIN_ARGS:-})
 for scene in ${SCENES:-dragon default}; do
   bench_scene "$scene" "$T"
   for L in ${LEVELS:-0 1 2}; do
     P=$T/${scene}_$L
     D=(--subdivide "$L")
     t0=$(date +%s.%N)
-    "$B" train "${SRC[@]}" "${NEURAL[@]}" "${D[@]}" --out "$P.nbvh" > "$OUT/train_${scene}_$L.log" 2>&1
+    "$B" train "${SRC[@]}" "${NEURAL[@]}" "${D[@]}" "${TA[@]}" --out "$P.nbvh" > "$OUT/train_${scene}_$L.log" 2>&1
     t1=$(date +%s.%N)
     echo "{\"train_wall_s\": $(python3 -c "print($t1 - $t0)")}" > "$P.train.json"
     C=("${SRC[@]}" "${NEURAL[@]}" --classical "${VIEW[@]}" "${D[@]}")

@@ -27,4 +27,18 @@ if SCENES=nowhere scripts/bench/variant_flips.sh "$W/bad" > "$W/bad.log" 2>&1; t
   echo "an unknown scene was accepted"; exit 1
 fi
 grep -q "bench_scene: scene must be default, dragon or chess, not 'nowhere'" "$W/bad.log" || { cat "$W/bad.log"; exit 1; }
+# dense_assets.sh: two --subdivide levels of the default scene, the asset's triangles 4x apart.
+SCENES=default LEVELS="0 1" FLIP_SPP=2 scripts/bench/dense_assets.sh "$W/dense" > "$W/dense.log" 2>&1 \
+  || { cat "$W/dense.log"; exit 1; }
+python3 - "$W/dense/dense.json" <<'PY'
+import json, math, sys
+rows = json.load(open(sys.argv[1]))["rows"]
+assert [(r["scene"], r["subdivide"]) for r in rows] == [("default", 0), ("default", 1)], rows
+assert rows[1]["asset_triangles"] == 4 * rows[0]["asset_triangles"], [r["asset_triangles"] for r in rows]
+for r in rows:
+    for k in ("hybrid_over_classical", "flip_hybrid_vs_ref", "flip_floor"):
+        assert math.isfinite(r[k]) and r[k] >= 0, (k, r[k])
+    assert r["classical"]["ms_per_spp"] > 0 and r["hybrid"]["neural"]["queries"] > 0, r
+print("dense_assets.sh dry run:", [(r["subdivide"], r["asset_triangles"], round(r["hybrid_over_classical"], 2)) for r in rows])
+PY
 echo "ok"
