@@ -4,15 +4,15 @@
 # the classical side's cost changes, as between a modest mesh and a dense scan of the same shape (the
 # paper's Statuette). One binary, one GPU call. Per scene and level:
 #   - a model trained by `nbvh train --subdivide L` with no other flag (its wall time recorded);
-#   - 1920x1080, SPP (16) spp, max depth 8, render defaults: classical, hybrid, classical, hybrid (the
-#     fastest of each; GPU timestamps), each after two untimed renders of the same image in its process
+#   - 1920x1080, SPP (16) spp, max depth 8, render defaults: classical, hybrid, classical, hybrid (REPS
+#     rounds, the fastest of each; GPU timestamps), each after two untimed renders of the same image in its process
 #     (`--warmup 2`: the GPU idles through a large scene's BVH build and starts the next frame at low
 #     clocks; separate warm-up processes do not help there);
 #   - at FLIP_W x FLIP_H (960x540), FLIP_SPP (2048) spp: a classical reference of seed 7, the classical
 #     render of seed 0 (the noise floor) and the hybrid of seed 0, LDR-FLIP of both against the reference.
 # Usage (GPU machine, after `source .device/env.sh`): SCENES="dragon default" LEVELS="0 1 2" \
 #   scripts/bench/dense_assets.sh OUT     (NBVH: the binary, default .device/study/bin/nbvh)
-# Env also: WIDTH, HEIGHT (1920x1080), TRAIN_ARGS (extra `nbvh train` flags; CI's dry run trains tiny CPU
+# Env also: WIDTH, HEIGHT (1920x1080), REPS (timed renders per side, 2), TRAIN_ARGS (extra `nbvh train` flags; CI's dry run trains tiny CPU
 # models with them, tests/bench/bench_scripts_dry_run.sh).
 # Writes OUT/dense.json (every row), OUT/train_SCENE_L.log, OUT/device.txt; prints a table.
 set -euo pipefail
@@ -38,7 +38,7 @@ for scene in ${SCENES:-dragon default}; do
     echo "{\"train_wall_s\": $(python3 -c "print($t1 - $t0)")}" > "$P.train.json"
     C=("${SRC[@]}" "${NEURAL[@]}" --classical "${VIEW[@]}" "${D[@]}")
     H=("${SRC[@]}" --model "$P.nbvh" "${VIEW[@]}" "${D[@]}")
-    for rep in 1 2; do
+    for rep in $(seq "${REPS:-2}"); do
       "$B" render "${C[@]}" "${R[@]}" --out "$T/c.png" --stats "$P.classical_$rep.json" > /dev/null 2>&1
       "$B" render "${H[@]}" "${R[@]}" --out "$T/h.png" --stats "$P.hybrid_$rep.json" > /dev/null 2>&1
     done
