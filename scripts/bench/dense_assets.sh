@@ -25,31 +25,7 @@ mkdir -p "$OUT" "$T"
 (nvidia-smi --query-gpu=name,driver_version --format=csv,noheader || echo "no nvidia-smi") | tee "$OUT/device.txt"
 R=(--width "${WIDTH:-1920}" --height "${HEIGHT:-1080}" --max-depth 8 --exposure 0 --spp "${SPP:-16}" --warmup 2)
 F=(--width "${FLIP_W:-960}" --height "${FLIP_H:-540}" --max-depth 8 --exposure 0 --spp "${FLIP_SPP:-2048}")
-# shellcheck disable=SC2206
-TA=(${TRAIN_ARGS:-})
-for scene in ${SCENES:-dragon default}; do
-  bench_scene "$scene" "$T"
-  for L in ${LEVELS:-0 1 2}; do
-    P=$T/${scene}_$L
-    D=(--subdivide "$L")
-    t0=$(date +%s.%N)
-    "$B" train "${SRC[@]}" "${NEURAL[@]}" "${D[@]}" "${TA[@]}" --out "$P.nbvh" > "$OUT/train_${scene}_$L.log" 2>&1
-    t1=$(date +%s.%N)
-    echo "{\"train_wall_s\": $(python3 -c "print($t1 - $t0)")}" > "$P.train.json"
-    C=("${SRC[@]}" "${NEURAL[@]}" --classical "${VIEW[@]}" "${D[@]}")
-    H=("${SRC[@]}" --model "$P.nbvh" "${VIEW[@]}" "${D[@]}")
-    for rep in $(seq "${REPS:-2}"); do
-      "$B" render "${C[@]}" "${R[@]}" --out "$T/c.png" --stats "$P.classical_$rep.json" > /dev/null 2>&1
-      "$B" render "${H[@]}" "${R[@]}" --out "$T/h.png" --stats "$P.hybrid_$rep.json" > /dev/null 2>&1
-    done
-    "$B" render "${C[@]}" "${F[@]}" --seed 7 --out "$P.ref.png" > /dev/null 2>&1
-    "$B" render "${C[@]}" "${F[@]}" --out "$P.cl.png" > /dev/null 2>&1
-    "$B" render "${H[@]}" "${F[@]}" --out "$P.hy.png" > /dev/null 2>&1
-    "$B" flip "$P.ref.png" "$P.cl.png" | tail -1 > "$P.flip_floor.txt"
-    "$B" flip "$P.ref.png" "$P.hy.png" | tail -1 > "$P.flip_hybrid.txt"
-    echo "done $scene L=$L ($(date +%T))"
-  done
-done
+summarize() { # OUT/dense.json from every level done so far (a call cut short keeps its finished rows)
 python3 - "$T" "$OUT/dense.json" "$B" <<'PY'
 import glob, json, os, re, sys
 t, out = sys.argv[1], sys.argv[2]
@@ -82,3 +58,31 @@ for r in rows:
         r["scene"], r["subdivide"], r["asset_triangles"], r["classical"]["ms_per_spp"], r["hybrid"]["ms_per_spp"],
         r["hybrid_over_classical"], r["train_wall_s"], r["flip_hybrid_vs_ref"], r["flip_floor"]))
 PY
+}
+# shellcheck disable=SC2206
+TA=(${TRAIN_ARGS:-})
+for scene in ${SCENES:-dragon default}; do
+  bench_scene "$scene" "$T"
+  for L in ${LEVELS:-0 1 2}; do
+    P=$T/${scene}_$L
+    D=(--subdivide "$L")
+    t0=$(date +%s.%N)
+    "$B" train "${SRC[@]}" "${NEURAL[@]}" "${D[@]}" "${TA[@]}" --out "$P.nbvh" > "$OUT/train_${scene}_$L.log" 2>&1
+    t1=$(date +%s.%N)
+    echo "{\"train_wall_s\": $(python3 -c "print($t1 - $t0)")}" > "$P.train.json"
+    C=("${SRC[@]}" "${NEURAL[@]}" --classical "${VIEW[@]}" "${D[@]}")
+    H=("${SRC[@]}" --model "$P.nbvh" "${VIEW[@]}" "${D[@]}")
+    for rep in $(seq "${REPS:-2}"); do
+      "$B" render "${C[@]}" "${R[@]}" --out "$T/c.png" --stats "$P.classical_$rep.json" > /dev/null 2>&1
+      "$B" render "${H[@]}" "${R[@]}" --out "$T/h.png" --stats "$P.hybrid_$rep.json" > /dev/null 2>&1
+    done
+    "$B" render "${C[@]}" "${F[@]}" --seed 7 --out "$P.ref.png" > /dev/null 2>&1
+    "$B" render "${C[@]}" "${F[@]}" --out "$P.cl.png" > /dev/null 2>&1
+    "$B" render "${H[@]}" "${F[@]}" --out "$P.hy.png" > /dev/null 2>&1
+    "$B" flip "$P.ref.png" "$P.cl.png" | tail -1 > "$P.flip_floor.txt"
+    "$B" flip "$P.ref.png" "$P.hy.png" | tail -1 > "$P.flip_hybrid.txt"
+    echo "done $scene L=$L ($(date +%T))"
+    summarize > "$OUT/table.txt"
+  done
+done
+cat "$OUT/table.txt"
