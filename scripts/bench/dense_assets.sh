@@ -19,10 +19,7 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 source scripts/bench/lib.sh
 OUT=$1
-B=${NBVH:-.device/study/bin/nbvh}
-T=${TMPDIR:-/tmp}/nbvh_dense
-mkdir -p "$OUT" "$T"
-(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader || echo "no nvidia-smi") | tee "$OUT/device.txt"
+bench_setup "$OUT" dense
 R=(--width "${WIDTH:-1920}" --height "${HEIGHT:-1080}" --max-depth 8 --exposure 0 --spp "${SPP:-16}" --warmup 2)
 F=(--width "${FLIP_W:-960}" --height "${FLIP_H:-540}" --max-depth 8 --exposure 0 --spp "${FLIP_SPP:-2048}")
 summarize() { # OUT/dense.json from every level done so far (a call cut short keeps its finished rows)

@@ -17,10 +17,7 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 source scripts/bench/lib.sh
 OUT=$1
-B=${NBVH:-.device/study/bin/nbvh}
-T=${TMPDIR:-/tmp}/nbvh_sweep
-mkdir -p "$OUT" "$T"
-(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader || echo "no nvidia-smi") | tee "$OUT/device.txt"
+bench_setup "$OUT" sweep
 # shellcheck disable=SC2206
 TA=(${TRAIN_ARGS:-})
 # shellcheck disable=SC2206

@@ -6,6 +6,15 @@ unpack() { # SRC.xz DST: xz, else Python's lzma (the GPU machine may have either
   else python3 -c 'import lzma, shutil, sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2], "wb"))' "$1" "$2"; fi
 }
 
+# bench_setup OUT NAME: sets B (the binary: NBVH, default .device/study/bin/nbvh) and T (a scratch folder,
+# TMPDIR/nbvh_NAME), creates both folders and writes OUT/device.txt (the GPU and driver, also printed).
+bench_setup() {
+  B=${NBVH:-.device/study/bin/nbvh}
+  T=${TMPDIR:-/tmp}/nbvh_$2
+  mkdir -p "$1" "$T"
+  (nvidia-smi --query-gpu=name,driver_version --format=csv,noheader || echo "no nvidia-smi") | tee "$1/device.txt"
+}
+
 # bench_scene NAME TMP: sets SRC (the scene), NEURAL (its neural-node flags: for training and for the
 # classical render) and VIEW (render-only flags: camera, environment, exposure) for default, dragon (every
 # mesh neural) or chess (the paper's camera and environment, scripts/bench/chess.sh), unpacking a carried
