@@ -20,6 +20,7 @@ cd "$(dirname "$0")/../.."
 source scripts/bench/lib.sh
 OUT=$1
 bench_setup "$OUT" dense
+rm -f "$T"/*.train.json # rows of an earlier call on a warm machine
 R=(--width "${WIDTH:-1920}" --height "${HEIGHT:-1080}" --max-depth 8 --exposure 0 --spp "${SPP:-16}" --warmup 2)
 F=(--width "${FLIP_W:-960}" --height "${FLIP_H:-540}" --max-depth 8 --exposure 0 --spp "${FLIP_SPP:-2048}")
 summarize() { # OUT/dense.json from every level done so far (a call cut short keeps its finished rows)
