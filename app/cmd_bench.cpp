@@ -39,6 +39,7 @@ struct BenchArgs {
     std::string scene, model, device = "auto", json, neural_path = "auto", camera, env, command_line;
     std::optional<float> env_rotation; // degrees
     uint32_t repeat = 3;
+    uint32_t subdivide = 0; // --subdivide (engine/scene/subdivide.h)
     render::RenderOptions options;
     BenchArgs() {
         options.width = 1920;
@@ -69,7 +70,8 @@ void run_bench(const BenchArgs& a) {
     render::RenderOptions options = a.options;
     options.neural.path = render::parse_neural_path(a.neural_path);
     if (a.repeat == 0) throw Error("--repeat must be at least 1");
-    const ModelScene ms = load_model_scene(a.scene, a.model, a.env, a.env_rotation, a.camera, options);
+    const ModelScene ms =
+        load_model_scene(a.scene, a.model, a.env, a.env_rotation, a.camera, options, a.subdivide);
     const NeuralModel& model = ms.model;
     const Scene& scene = ms.scene;
     const Environment& env = ms.env;
@@ -166,6 +168,7 @@ void add_bench_command(CLI::App& app, const std::string& command_line) {
     cmd->add_option("--json", args->json, "write the table (and per-pass GPU times) as JSON");
     cmd->add_option("--neural-path", args->neural_path, "MLP implementation: auto, scalar or coopmat");
     cmd->add_option("--camera", args->camera, "eye_x,eye_y,eye_z,target_x,target_y,target_z,fov_deg");
+    add_subdivide_option(cmd, args->subdivide);
     cmd->add_option("--env", args->env, "environment map (.hdr or .exr, equirectangular), or 'none' (the scene's lights only)");
     cmd->add_option("--env-rotation", args->env_rotation, "rotate the environment about +y by this many degrees")
         ->check(CLI::Range(-3600.0f, 3600.0f));

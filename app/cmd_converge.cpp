@@ -46,6 +46,7 @@ struct ConvergeArgs {
                                               secondary_lod = "coarsest", command_line;
     std::optional<float> env_rotation; // degrees
     uint32_t from = 128, lod = 0;
+    uint32_t subdivide = 0;            // --subdivide (engine/scene/subdivide.h)
     std::optional<uint32_t> ref_spp;   // default 4 x --spp
     render::RenderOptions options;
     ConvergeArgs() {
@@ -100,7 +101,8 @@ void run_converge(const ConvergeArgs& a) {
     base.neural.path = render::parse_neural_path(a.neural_path);
     base.neural.lod = a.lod;
     base.neural.secondary_lod = parse_secondary_lod(a.secondary_lod);
-    const ModelScene ms = load_model_scene(a.scene, a.model, a.env, a.env_rotation, a.camera, base);
+    const ModelScene ms =
+        load_model_scene(a.scene, a.model, a.env, a.env_rotation, a.camera, base, a.subdivide);
     const NeuralModel& model = ms.model;
     const Scene& scene = ms.scene;
     const Environment& env = ms.env;
@@ -225,6 +227,7 @@ void add_converge_command(CLI::App& app, const std::string& command_line) {
     cmd->add_option("--csv", args->csv, "write the table as CSV");
     cmd->add_option("--neural-path", args->neural_path, "MLP implementation: auto, scalar or coopmat");
     cmd->add_option("--camera", args->camera, "eye_x,eye_y,eye_z,target_x,target_y,target_z,fov_deg");
+    add_subdivide_option(cmd, args->subdivide);
     cmd->add_option("--env", args->env, "environment map (.hdr or .exr), or 'none' (the scene's lights only)");
     cmd->add_option("--env-rotation", args->env_rotation, "rotate the environment about +y by this many degrees")
         ->check(CLI::Range(-3600.0f, 3600.0f));

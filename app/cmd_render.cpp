@@ -35,7 +35,6 @@
 #include "engine/render/wavefront.h"
 #include "engine/scene/camera.h"
 #include "engine/scene/environment.h"
-#include "engine/scene/subdivide.h"
 #include "engine/vk/context.h"
 
 namespace nbvh::app {
@@ -250,11 +249,7 @@ void add_render_command(CLI::App& app, const std::string& command_line) {
            "render the image this many times first, untimed, in the same process (GPU clocks and caches "
            "settle before the timed render that is written; for benchmarks)")
         ->check(CLI::Range(0u, 16u));
-    cmd->add_option(
-           "--subdivide", args->subdivide,
-           "split every triangle into 4, L times: the same surface in 4^L times the triangles (a dense "
-           "asset's classical cost; a model must be trained with the same --subdivide)")
-        ->check(CLI::Range(0u, MAX_SUBDIVISION_LEVELS));
+    add_subdivide_option(cmd, args->subdivide);
     cmd->add_option("--lod", args->options.neural.lod, "N-BVH level of detail of camera rays (0 = finest)");
     cmd->add_option("--secondary-lod", args->secondary_lod,
                     "N-BVH level of detail after the first hit: coarsest (default: the model's coarsest LoD, "

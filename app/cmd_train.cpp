@@ -19,7 +19,6 @@
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/neural/model_file.h"
-#include "engine/scene/subdivide.h"
 #include "engine/vk/context.h"
 #include "trainer/compact_hash.h"
 #include "trainer/evaluation.h"
@@ -165,11 +164,7 @@ void add_train_command(CLI::App& app) {
     cmd->add_option("--steps", args->steps, "optimiser steps (CPU default 1000, CUDA 10000)");
     cmd->add_option("--batch", args->batch, "rays per step (CPU default 2048, CUDA 262144)");
     cmd->add_option("--lods", args->lods, "cuts kept as levels of detail (1..8, default 3: render and view trace rays after the first hit on the coarsest)");
-    cmd->add_option(
-           "--subdivide", args->subdivide,
-           "split every triangle into 4, L times: the same surface in 4^L times the triangles (a dense "
-           "asset's classical cost; render the model with the same --subdivide)")
-        ->check(CLI::Range(0u, MAX_SUBDIVISION_LEVELS));
+    add_subdivide_option(cmd, args->subdivide);
     cmd->add_option("--seed", args->seed, "random seed (network init and rays)");
     cmd->add_option("--threads", args->threads, "CPU backend threads (default: all cores)");
     cmd->add_flag("--deterministic", args->deterministic, "CUDA backend: bit-reproducible steps (slower)");

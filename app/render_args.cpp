@@ -9,6 +9,7 @@
 #include "engine/core/log.h"
 #include "engine/scene/camera.h"
 #include "engine/scene/environment.h"
+#include "engine/scene/subdivide.h"
 
 namespace nbvh::app {
 
@@ -100,16 +101,27 @@ Camera choose_camera(const Scene& scene, const std::string& camera_arg, const re
     return scene.has_camera ? scene.camera : auto_frame(scene, aspect);
 }
 
-ModelScene load_model_scene(const std::string& scene_arg, const std::string& model_path, const std::string& env_path,
-                            std::optional<float> env_rotation_deg, const std::string& camera_arg,
-                            const render::RenderOptions& o) {
+ModelScene load_model_scene(const std::string& scene_arg, const std::string& model_path,
+                            const std::string& env_path, std::optional<float> env_rotation_deg,
+                            const std::string& camera_arg, const render::RenderOptions& o,
+                            uint32_t subdivide) {
     ModelScene m;
     m.model = load_model(model_path);
-    m.scene = load_scene_for_model(scene_arg, {}, &m.model, model_path);
+    SceneLoadOptions lo;
+    lo.subdivide = subdivide;
+    m.scene = load_scene_for_model(scene_arg, lo, &m.model, model_path);
     m.env = choose_environment(m.scene, env_path);
     if (env_rotation_deg) m.env.rotation = *env_rotation_deg * 3.14159265358979f / 180.0f;
     m.camera = choose_camera(m.scene, camera_arg, o);
     return m;
+}
+
+void add_subdivide_option(CLI::App* cmd, uint32_t& levels) {
+    cmd->add_option(
+           "--subdivide", levels,
+           "split every triangle into 4, L times: the same surface in 4^L times the triangles (a dense "
+           "asset's classical cost); a model is used with the --subdivide it was trained with")
+        ->check(CLI::Range(0u, MAX_SUBDIVISION_LEVELS));
 }
 
 std::optional<float> parse_exposure(const std::string& text) {

@@ -39,9 +39,14 @@ struct ModelScene {
     Environment env;
     Camera camera;
 };
-ModelScene load_model_scene(const std::string& scene_arg, const std::string& model_path, const std::string& env_path,
-                            std::optional<float> env_rotation_deg, const std::string& camera_arg,
-                            const render::RenderOptions& o);
+ModelScene load_model_scene(const std::string& scene_arg, const std::string& model_path,
+                            const std::string& env_path, std::optional<float> env_rotation_deg,
+                            const std::string& camera_arg, const render::RenderOptions& o,
+                            uint32_t subdivide = 0);
+
+// --subdivide L (engine/scene/subdivide.h) for every command that loads a scene: the same surface in 4^L
+// times the triangles; a model is used with the --subdivide it was trained with.
+void add_subdivide_option(CLI::App* cmd, uint32_t& levels);
 
 // --exposure: "auto" (nullopt) or a number of stops in [-24, 24]; throws nbvh::Error otherwise.
 std::optional<float> parse_exposure(const std::string& text);

@@ -236,6 +236,19 @@ TEST(CliTrain, SubdivideMustMatchBetweenTrainingAndRender) {
     r.insert(r.end(), {"--subdivide", "9"});
     EXPECT_CLEAN_ERROR(run_nbvh(r, 20.0), "--subdivide");
     EXPECT_FALSE(fs::exists(dir / "o.png"));
+    // bench and converge load the scene of a model the same way, with the same option.
+    for (const char* cmd : {"bench", "converge"}) {
+        SCOPED_TRACE(cmd);
+        EXPECT_CLEAN_ERROR(run_nbvh({cmd, "default", "--model", (dir / "m.nbvh").string(), "--device", "cpu",
+                                     "--subdivide", "9"},
+                                    20.0),
+                           "--subdivide");
+        std::vector<std::string> a = {cmd,        "default", "--model", (dir / "m.nbvh").string(),
+                                      "--device", "cpu",     "--width", "16",
+                                      "--height", "16",      "--spp",   "2"};
+        if (std::string(cmd) == "converge") a.insert(a.end(), {"--from", "1"});
+        EXPECT_CLEAN_ERROR_AFTER_INFO(run_nbvh(a, 60.0), "--subdivide differs");
+    }
 }
 
 // --device picks the GPU that CUDA trains on, numbered as every other command's --device (Vulkan, PCI
