@@ -1,12 +1,12 @@
 // Flat midpoint subdivision: the same surface in 4^L times the triangles (`--subdivide L` of `nbvh render`,
-// `train`, `bench` and `converge`). Each triangle (a, b, c) becomes four, through the midpoints of its edges; a midpoint
-// is shared by the triangles on both sides of its edge (a watertight mesh stays watertight). The new
-// vertices lie on the original triangles, so what a ray hits does not change (up to float rounding of the
-// midpoints): only the classical side's cost grows (BVH depth, memory beyond the GPU's caches), which is
-// how a dense scan (the paper's Statuette, 642 MB) differs from a modest mesh of the same shape.
-// Per-vertex attributes are interpolated at the midpoints (normals and tangent directions renormalised,
-// a tangent's handedness taken from the edge's lower-indexed vertex); each new triangle keeps its parent's
-// material.
+// `train`, `bench` and `converge`). Each triangle (a, b, c) becomes four, through the midpoints of its
+// edges; a midpoint is shared by the triangles on both sides of its edge (a watertight mesh stays
+// watertight). The new vertices lie on the original triangles, so what a ray hits does not change (up to
+// float rounding of the midpoints): only the classical side's cost grows (BVH depth, memory beyond the
+// GPU's caches), which is how a dense scan (the paper's Statuette, 642 MB) differs from a modest mesh of
+// the same shape. Per-vertex attributes are interpolated at the midpoints (normals and tangent directions
+// renormalised, a tangent's handedness taken from the edge's lower-indexed vertex); each new triangle
+// keeps its parent's material.
 #pragma once
 #include <cstdint>
 
