@@ -157,6 +157,7 @@ void run_render(const RenderArgs& a) {
     // decides which instances are neural.
     Scene scene = load_scene_for_model(a.scene, lo, a.model.empty() ? nullptr : &model, a.model);
     if (!a.model.empty() && !options.neural.classical) options.neural.model = &model;
+    options.neural.keep_neural_triangles = false; // one render, never switched to the classical reference
     options.neural.path = render::parse_neural_path(a.neural_path);
     Environment env = choose_environment(scene, a.env);
     if (a.env_rotation) env.rotation = *a.env_rotation * 3.14159265358979f / 180.0f;

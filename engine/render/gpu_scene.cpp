@@ -156,6 +156,23 @@ void pack_punctual_lights(const Scene& scene, GpuSceneData& out) {
 
 } // namespace
 
+std::vector<bool> omitted_neural_meshes(const Scene& scene) {
+    std::vector<bool> omit(scene.meshes.size(), false), seen(scene.meshes.size(), false);
+    for (const Instance& i : scene.instances)
+        if (i.mesh < scene.meshes.size()) {
+            omit[i.mesh] = seen[i.mesh] ? omit[i.mesh] && i.neural : i.neural;
+            seen[i.mesh] = true;
+        }
+    for (size_t m = 0; m < scene.meshes.size(); ++m)
+        for (uint32_t mat : scene.meshes[m].triangle_material) {
+            const uint32_t packed = mat < scene.materials.size() ? mat : 0u; // as pack_scene packs it
+            if (omit[m] && packed < scene.materials.size() &&
+                nb_luminance(scene.materials[packed].emissive) > 0.0f)
+                omit[m] = false;
+        }
+    return omit;
+}
+
 GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Environment& environment,
                         const PackOptions& options) {
     GpuSceneData out;
@@ -165,9 +182,23 @@ GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Envir
     // Vertices and per-mesh triangles in BLAS leaf order; BLAS nodes concatenated.
     std::vector<uint32_t> mesh_vertex_base(scene.meshes.size()), mesh_triangle_base(scene.meshes.size()),
         mesh_blas_root(scene.meshes.size());
+    uint32_t empty_blas = BVH_INVALID; // the node omitted meshes point at (added on first use)
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const Mesh& mesh = scene.meshes[m];
         const MeshBvh& blas = accel.meshes[m];
+        if (m < options.omit_mesh.size() && options.omit_mesh[m]) {
+            if (empty_blas == BVH_INVALID) {
+                empty_blas = uint32_t(out.blas_nodes.size());
+                out.blas_nodes.push_back(to_wide_layout(Bvh{})[0]);
+            }
+            mesh_vertex_base[m] = mesh_triangle_base[m] = 0;
+            mesh_blas_root[m] = empty_blas;
+            ++out.omitted_meshes;
+            out.omitted_bytes += uint64_t(mesh.positions.size()) * sizeof(GpuVertex) +
+                                 uint64_t(blas.bvh.prim_indices.size()) * sizeof(GpuTriangle) +
+                                 uint64_t(to_wide_layout(blas.bvh).size()) * sizeof(GpuWideNode);
+            continue;
+        }
         mesh_vertex_base[m] = uint32_t(out.vertices.size());
         for (size_t v = 0; v < mesh.positions.size(); ++v) {
             GpuVertex g{};
@@ -244,6 +275,8 @@ GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Envir
             const uint32_t si = out.instance_to_scene[gi];
             if (out.instances[gi].kind == NB_INSTANCE_CAMERA_ONLY) continue; // lights nothing it could shadow
             const uint32_t mesh = accel.instance_mesh[si];
+            if (mesh < options.omit_mesh.size() && options.omit_mesh[mesh])
+                continue; // emits nothing (omitted_neural_meshes)
             const glm::mat4& o2w = accel.object_to_world[si];
             const uint32_t first = mesh_triangle_base[mesh];
             const uint32_t count = accel.meshes[mesh].triangle_count();

@@ -36,6 +36,8 @@ struct GpuSceneData {
     float scene_extent = 1.0f;                  // world bounds diagonal (m)
     uint32_t texture_downscales = 0;            // halvings applied to fit the texel budget
     uint32_t outline_shells = 0;                // instances packed as NB_INSTANCE_CAMERA_ONLY
+    uint32_t omitted_meshes = 0;                // meshes left out (PackOptions::omit_mesh)
+    uint64_t omitted_bytes = 0;                 // their vertices, triangles and BLAS nodes
 };
 
 struct PackOptions {
@@ -43,7 +45,14 @@ struct PackOptions {
     bool textures = true;
     uint64_t texel_budget_bytes = 96ull << 20;  // below lavapipe's 128 MiB per binding (texture_path.h)
     uint64_t environment_budget_bytes = UINT64_MAX; // the environment map is halved until its table fits
+    // Per Scene::meshes entry (empty: none): not uploaded. Its vertices, triangles and BLAS nodes are left
+    // out, its instances point at an empty BLAS and add no light. For meshes only the model answers for
+    // (omitted_neural_meshes).
+    std::vector<bool> omit_mesh;
 };
+
+// The meshes a hybrid-only render need not upload: every instance neural, no emissive material.
+std::vector<bool> omitted_neural_meshes(const Scene& scene);
 
 // `environment` is the one the render uses (scene's, --env, or the default sky).
 GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Environment& environment,

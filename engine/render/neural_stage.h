@@ -71,6 +71,11 @@ struct NeuralRenderOptions {
     // back-facing neural hits, so that it leaves the asset instead of bouncing inside it
     // (NB_RAY_BACKFACE_BIT, engine/render/NEURAL.md). --neural-backface-escape on|off.
     bool backface_escape = true;
+    // false (a hybrid render that never switches to the classical reference, as `nbvh render --model`):
+    // the meshes whose every instance is neural and that emit no light are not uploaded (vertices,
+    // triangles, BLAS), so the GPU memory of a hybrid render no longer grows with the triangles the
+    // model replaces; such a renderer cannot switch to the classical reference (apply() returns false).
+    bool keep_neural_triangles = true;
 };
 
 // Leaves per round of `options` (throws nbvh::Error when out of range).

@@ -82,7 +82,17 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     pack.textures = texture_plan_.path == TexturePath::buffer;
     pack.texel_budget_bytes = texel_budget_bytes(range);
     pack.environment_budget_bytes = range;
+    // A hybrid render that never switches to the classical reference leaves the triangles only the model
+    // answers for on the host (NeuralRenderOptions::keep_neural_triangles).
+    if (options_.neural.model && !options_.neural.classical && !options_.neural.keep_neural_triangles)
+        pack.omit_mesh = omitted_neural_meshes(scene);
     data_ = pack_scene(scene, accel, environment, pack);
+    triangles_omitted_ = data_.omitted_meshes > 0;
+    if (triangles_omitted_)
+        log_info("render: %u neural mesh%s not uploaded (%.1f MiB of vertices, triangles and BLAS: the model "
+                 "answers for them)",
+                 data_.omitted_meshes, data_.omitted_meshes == 1 ? "" : "es",
+                 double(data_.omitted_bytes) / double(1 << 20));
     if (texture_array) {
         texture_array_ = TextureArray(ctx_, scene.textures);
         texture_plan_.bytes = texture_array_.bytes();
@@ -260,11 +270,12 @@ bool WavefrontRenderer::apply(const RenderOptions& o) {
     const bool overrides = n.roughness >= 0.0f || n.metallic >= 0.0f;
     const bool swap = n.model && cn.model && n.model != cn.model && neural_;
     if (o.width != c.width || o.height != c.height || o.max_wave_pixels != c.max_wave_pixels ||
-        o.wave_memory_share != c.wave_memory_share ||
-        (n.model != cn.model && !swap) || n.path != cn.path ||
+        o.wave_memory_share != c.wave_memory_share || (n.model != cn.model && !swap) || n.path != cn.path ||
         (n.model && effective_leaves_per_round(n) != neural_->leaves_per_round()) ||
-        (n.classical && overrides) != classical_overrides_ || (n.model && !features_.neural && !n.classical) ||
-        !(o.forced_features == c.forced_features) || capacity_ > counter_safe_paths(o))
+        (n.classical && overrides) != classical_overrides_ ||
+        (n.model && !features_.neural && !n.classical) || (n.classical && triangles_omitted_) ||
+        n.keep_neural_triangles != cn.keep_neural_triangles || !(o.forced_features == c.forced_features) ||
+        capacity_ > counter_safe_paths(o))
         return false;
     if (n.model) validate(n, *scene_);
     if (swap) swap_model(n);

@@ -200,6 +200,7 @@ private:
     std::unique_ptr<NeuralStage> neural_; // renders with a model (hybrid or its classical reference)
     bool hybrid_ = false;                 // neural instances through the N-BVH (else their triangles)
     bool classical_overrides_ = false;    // the classical reference's triangles carry material overrides
+    bool triangles_omitted_ = false;      // neural-only meshes not uploaded (keep_neural_triangles false)
     vk::Buffer other_instances_;          // the instance array not bound (classical <-> hybrid)
     uint64_t live_updates_ = 0, model_swaps_ = 0;
     vk::GpuTimer timer_;

@@ -241,6 +241,45 @@ TEST(HybridRender, SortedRaysKeepTheImage) {
         }
 }
 
+// keep_neural_triangles = false (what `nbvh render --model` sets): the bunny's triangles, vertices and
+// BLAS are not uploaded, the image is the same bytes, and the renderer refuses to switch to the classical
+// reference (it has no triangles for it) while one that keeps them switches.
+TEST(HybridRender, OmittedNeuralTrianglesKeepTheImage) {
+    NBVH_REQUIRE_SHARED();
+    const Fixture& f = trained_bunny();
+    vk::ContextOptions co;
+    co.device = vk::DeviceChoice::cpu;
+    co.validation = true;
+    vk::Context ctx(co);
+    const SceneAccel accel = build_scene_accel(f.scene);
+    const Camera cam = auto_frame(f.scene, 1.0f);
+    RenderOptions o;
+    o.width = o.height = 48;
+    o.spp = 2;
+    o.max_depth = 3;
+    o.neural.model = &f.model;
+    o.neural.path = NeuralPath::scalar;
+    WavefrontRenderer keep(ctx, f.scene, accel, default_sky(), cam, o);
+    RenderOptions lean_o = o;
+    lean_o.neural.keep_neural_triangles = false;
+    WavefrontRenderer lean(ctx, f.scene, accel, default_sky(), cam, lean_o);
+    EXPECT_EQ(keep.scene_data().omitted_meshes, 0u);
+    EXPECT_EQ(lean.scene_data().omitted_meshes, 1u);
+    EXPECT_GT(lean.scene_data().omitted_bytes, 1000000u) << "the bunny's vertices, triangles and BLAS";
+    EXPECT_LT(lean.scene_data().triangles.size(), keep.scene_data().triangles.size() / 100);
+    const RenderResult a = keep.render(), b = lean.render();
+    EXPECT_GT(a.stats.neural_queries, 0u);
+    EXPECT_EQ(a.stats.neural_queries, b.stats.neural_queries);
+    EXPECT_EQ(a.image.data, b.image.data);
+    RenderOptions classical = o;
+    classical.neural.classical = true;
+    RenderOptions lean_classical = lean_o;
+    lean_classical.neural.classical = true;
+    EXPECT_FALSE(lean.apply(lean_classical)) << "no triangles to switch to: a new renderer is needed";
+    EXPECT_TRUE(keep.apply(classical));
+    EXPECT_EQ(ctx.validation_message_count(), 0);
+}
+
 TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
     NBVH_REQUIRE_SHARED();
     Fixture f; // no training needed: validate() reads the scene's neural flags and the model's LoD count
