@@ -476,6 +476,17 @@ TEST(MultiAsset, SettingsApplyWithoutRebuildMatchFreshRenderers) {
     const Image c1 = live.render().image;
     EXPECT_EQ(live.live_updates(), 3u);
     EXPECT_EQ(h.data, fresh(o).data);
+    // Without the neural-only meshes on the GPU (`nbvh render --model`): the same hybrid image beside the
+    // classical assets, the neural meshes left out, no switch to the classical reference.
+    RenderOptions lean = o;
+    lean.neural.keep_neural_triangles = false;
+    WavefrontRenderer lean_renderer(ctx, scene, accel, default_sky(), scene.camera, lean);
+    EXPECT_GE(lean_renderer.scene_data().omitted_meshes, 4u); // ball's two parts, bricks, pillar
+    EXPECT_LT(lean_renderer.scene_data().omitted_meshes, scene.meshes.size()) << "the classical meshes stay";
+    EXPECT_EQ(lean_renderer.render().image.data, h.data);
+    RenderOptions lean_classical = lean;
+    lean_classical.neural.classical = true;
+    EXPECT_FALSE(lean_renderer.apply(lean_classical));
     EXPECT_EQ(d.data, fresh(deeper).data);
     EXPECT_EQ(c0.data, c1.data);
     EXPECT_NE(h.data, c0.data); // the hybrid image is not the classical one
