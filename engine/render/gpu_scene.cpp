@@ -5,6 +5,7 @@
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
+#include "engine/render/gpu_memory.h"
 #include "engine/render/texture_path.h"
 #include "engine/scene/outline_shells.h"
 #include "shaders/shared/sampling.h"
@@ -194,9 +195,7 @@ GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Envir
             mesh_vertex_base[m] = mesh_triangle_base[m] = 0;
             mesh_blas_root[m] = empty_blas;
             ++out.omitted_meshes;
-            out.omitted_bytes += uint64_t(mesh.positions.size()) * sizeof(GpuVertex) +
-                                 uint64_t(blas.bvh.prim_indices.size()) * sizeof(GpuTriangle) +
-                                 uint64_t(to_wide_layout(blas.bvh).size()) * sizeof(GpuWideNode);
+            out.omitted_bytes += mesh_gpu_bytes(mesh, blas);
             continue;
         }
         mesh_vertex_base[m] = uint32_t(out.vertices.size());
