@@ -10,6 +10,7 @@
 // Loads the scene, builds its BVHs, runs the wavefront path tracer (engine/render/) and writes the image
 // (PNG: exposure (auto by default, engine/core/exposure.h), ACES-fit tone map + sRGB, engine/core/image.h;
 // EXR: linear radiance).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -32,6 +33,7 @@
 #include "engine/core/image.h"
 #include "engine/core/log.h"
 #include "engine/neural/model_file.h"
+#include "engine/render/gpu_scene.h"
 #include "engine/render/wavefront.h"
 #include "engine/scene/camera.h"
 #include "engine/scene/environment.h"
@@ -179,9 +181,16 @@ void run_render(const RenderArgs& a) {
     }
     vk::Context ctx(copt); // before the BVH build: a missing device fails fast
     const auto t0 = std::chrono::steady_clock::now();
-    const SceneAccel accel = build_scene_accel(scene);
-    log_info("render: BVHs built in %.1f ms", std::chrono::duration<double, std::milli>(
-                                                  std::chrono::steady_clock::now() - t0).count());
+    // A hybrid render leaves the meshes only the model answers for on the host (keep_neural_triangles
+    // false above), so their BLAS is never read: their instances get their bounds only.
+    const std::vector<bool> bounds_only =
+        options.neural.model ? render::omitted_neural_meshes(scene) : std::vector<bool>();
+    const SceneAccel accel = build_scene_accel_bounds_only(scene, bounds_only);
+    log_info("render: BVHs built in %.1f ms%s",
+             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count(),
+             std::count(bounds_only.begin(), bounds_only.end(), true) > 0
+                 ? " (the neural-only meshes' bounds only: the model answers for them)"
+                 : "");
     render::WavefrontRenderer renderer(ctx, scene, accel, env, camera, options);
     // --warmup: the same image rendered first, untimed. A GPU left idle by a long CPU phase (a large
     // scene's BVH build) starts at low clocks: an H200's 16-spp 1080p frames ran 3-5x slow right after

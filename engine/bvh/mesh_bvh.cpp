@@ -2,6 +2,7 @@
 #include "engine/bvh/mesh_bvh.h"
 
 #include "engine/bvh/aabb_ops.h"
+#include "engine/core/error.h"
 #include "shaders/shared/intersect.h"
 
 namespace nbvh {
@@ -19,6 +20,19 @@ bool triangle_vertices(const Mesh& mesh, uint32_t t, glm::vec3& a, glm::vec3& b,
     return true;
 }
 
+// The box of triangle `t`, or false when the builder skips it (an index out of range, a non-finite vertex).
+bool triangle_box(const Mesh& mesh, uint32_t t, Aabb& box) {
+    glm::vec3 a, b, c;
+    if (!triangle_vertices(mesh, t, a, b, c)) return false;
+    // Aabb::grow drops NaN (glm min/max), so test the vertices themselves.
+    if (!is_finite(a) || !is_finite(b) || !is_finite(c)) return false;
+    box = Aabb{};
+    box.grow(a);
+    box.grow(b);
+    box.grow(c);
+    return true;
+}
+
 } // namespace
 
 BvhBuildOptions default_blas_options() {
@@ -32,17 +46,7 @@ BvhBuildOptions default_blas_options() {
 MeshBvh build_mesh_bvh(const Mesh& mesh, const BvhBuildOptions& options) {
     const uint32_t tri_count = mesh.triangle_count();
     std::vector<Aabb> bounds(tri_count); // empty (skipped) unless the triangle is valid
-    for (uint32_t t = 0; t < tri_count; ++t) {
-        glm::vec3 a, b, c;
-        if (!triangle_vertices(mesh, t, a, b, c)) continue;
-        // Aabb::grow drops NaN (glm min/max), so test the vertices themselves.
-        if (!is_finite(a) || !is_finite(b) || !is_finite(c)) continue;
-        Aabb box;
-        box.grow(a);
-        box.grow(b);
-        box.grow(c);
-        bounds[t] = box;
-    }
+    for (uint32_t t = 0; t < tri_count; ++t) triangle_box(mesh, t, bounds[t]);
     MeshBvh out;
     out.bvh = build_bvh(bounds, options);
     out.vertices.resize(3 * out.bvh.prim_indices.size());
@@ -53,12 +57,25 @@ MeshBvh build_mesh_bvh(const Mesh& mesh, const BvhBuildOptions& options) {
     return out;
 }
 
+MeshBvh bounds_only_mesh_bvh(const Mesh& mesh) {
+    MeshBvh out;
+    out.bounds_only = true;
+    Aabb box;
+    // The builder's root box is the union of the valid triangles' boxes: min and max in any order give
+    // the same floats.
+    for (uint32_t t = 0; t < mesh.triangle_count(); ++t)
+        if (triangle_box(mesh, t, box)) out.only_bounds.grow(box);
+    return out;
+}
+
 namespace {
 
 // Shared by closest and any hit: `any` stops at the first accepted triangle.
 template <bool any>
 bool intersect(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit,
                const HitFilter* accept = nullptr) {
+    if (mesh.bounds_only)
+        throw Error("BLAS query on a mesh built for its bounds only (bounds_only_mesh_bvh)");
     bool found = false;
     const glm::vec3* v = mesh.vertices.data();
     const Bvh& bvh = mesh.bvh;

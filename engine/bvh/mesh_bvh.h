@@ -23,8 +23,13 @@ struct MeshBvh {
     // (glTF doubleSided false; the GPU traversal does the same). Empty: nothing is culled (build_mesh_bvh
     // leaves it empty; build_scene_accel fills it from the scene's materials).
     std::vector<uint8_t> single_sided;
-    uint32_t triangle_count() const { return uint32_t(bvh.prim_indices.size()); }
-    Aabb bounds() const { return bvh.empty() ? Aabb{} : bvh.nodes[0].bounds; }
+    // Set by bounds_only_mesh_bvh: no tree and no vertices, only `only_bounds`, the box of the valid
+    // triangles (the root box build_mesh_bvh gives, bit for bit). The CPU queries below throw on it.
+    bool bounds_only = false;
+    Aabb only_bounds;
+    uint32_t triangle_count() const { return uint32_t(bvh.prim_indices.size()); }  // 0 when bounds_only
+    bool empty() const { return bounds_only ? only_bounds.empty() : bvh.empty(); } // no valid triangle
+    Aabb bounds() const { return bounds_only ? only_bounds : bvh.empty() ? Aabb{} : bvh.nodes[0].bounds; }
 };
 
 struct Hit {
@@ -38,12 +43,17 @@ BvhBuildOptions default_blas_options();
 
 MeshBvh build_mesh_bvh(const Mesh& mesh, const BvhBuildOptions& options = default_blas_options());
 
+// The bounds of `mesh` as build_mesh_bvh's root gives them, without building the tree (one pass over the
+// triangles): for a mesh nothing on the CPU traces and nothing uploads (a hybrid render's neural-only
+// meshes, render/gpu_scene.h omitted_neural_meshes), whose instances only need their world bounds.
+MeshBvh bounds_only_mesh_bvh(const Mesh& mesh);
+
 // Which candidate hits count (alpha-tested surfaces): original triangle index, ray parameter and
 // barycentrics. A filter that accepts nothing visits every crossing of [tmin, tmax].
 using HitFilter = std::function<bool(uint32_t triangle, float t, float u, float v)>;
 
 // Closest hit with t in [tmin, tmax]; `hit` is written only when it returns true. With `accept`, only
-// the hits it accepts.
+// the hits it accepts. Both queries throw nbvh::Error on a bounds-only MeshBvh.
 bool intersect_closest(const MeshBvh& mesh, const Ray& ray, float tmin, float tmax, Hit& hit,
                        const HitFilter* accept = nullptr);
 // Any hit with t in [tmin, tmax] (shadow rays).

@@ -68,11 +68,18 @@ BvhBuildOptions default_tlas_options() {
     return o;
 }
 
-SceneAccel build_scene_accel(const Scene& scene, const BvhBuildOptions& blas_options,
-                             const BvhBuildOptions& tlas_options) {
+namespace {
+
+SceneAccel build(const Scene& scene, const BvhBuildOptions& blas_options, const BvhBuildOptions& tlas_options,
+                 const std::vector<bool>& bounds_only) {
     SceneAccel accel;
     accel.meshes.reserve(scene.meshes.size());
-    for (const Mesh& mesh : scene.meshes) {
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+        const Mesh& mesh = scene.meshes[m];
+        if (m < bounds_only.size() && bounds_only[m]) {
+            accel.meshes.push_back(bounds_only_mesh_bvh(mesh));
+            continue;
+        }
         accel.meshes.push_back(build_mesh_bvh(mesh, blas_options));
         accel.meshes.back().single_sided = single_sided_flags(mesh, accel.meshes.back(), scene.materials);
     }
@@ -86,7 +93,7 @@ SceneAccel build_scene_accel(const Scene& scene, const BvhBuildOptions& blas_opt
         const Instance& inst = scene.instances[i];
         accel.object_to_world[i] = inst.object_to_world;
         accel.instance_mesh[i] = inst.mesh;
-        if (inst.mesh >= accel.meshes.size() || accel.meshes[inst.mesh].bvh.empty()) continue;
+        if (inst.mesh >= accel.meshes.size() || accel.meshes[inst.mesh].empty()) continue;
         glm::mat4 inv;
         if (!safe_inverse(inst.object_to_world, inv)) continue;
         accel.world_to_object[i] = inv;
@@ -95,6 +102,17 @@ SceneAccel build_scene_accel(const Scene& scene, const BvhBuildOptions& blas_opt
     }
     accel.tlas = build_bvh(accel.instance_bounds, tlas_options);
     return accel;
+}
+
+} // namespace
+
+SceneAccel build_scene_accel(const Scene& scene, const BvhBuildOptions& blas_options,
+                             const BvhBuildOptions& tlas_options) {
+    return build(scene, blas_options, tlas_options, {});
+}
+
+SceneAccel build_scene_accel_bounds_only(const Scene& scene, const std::vector<bool>& bounds_only) {
+    return build(scene, default_blas_options(), default_tlas_options(), bounds_only);
 }
 
 bool intersect_closest(const SceneAccel& accel, const Ray& ray, float tmin, float tmax, SceneHit& hit) {

@@ -13,7 +13,8 @@ namespace nbvh::render {
 
 // A mesh as pack_scene uploads it: every vertex (GpuVertex), the triangles its BLAS keeps (GpuTriangle) and
 // the BLAS nodes (GpuWideNode, to_wide_layout). Textures and materials are not counted (both
-// representations shade with them).
+// representations shade with them). A bounds-only BLAS (bounds_only_mesh_bvh) counts the vertices and every
+// triangle of the mesh, no nodes (none were built).
 uint64_t mesh_gpu_bytes(const Mesh& mesh, const MeshBvh& blas);
 uint64_t mesh_gpu_bytes(const Mesh& mesh); // builds the BLAS with default_blas_options()
 

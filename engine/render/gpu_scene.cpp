@@ -195,9 +195,13 @@ GpuSceneData pack_scene(const Scene& scene, const SceneAccel& accel, const Envir
             mesh_vertex_base[m] = mesh_triangle_base[m] = 0;
             mesh_blas_root[m] = empty_blas;
             ++out.omitted_meshes;
+            out.omitted_unbuilt += blas.bounds_only ? 1u : 0u;
             out.omitted_bytes += mesh_gpu_bytes(mesh, blas);
             continue;
         }
+        if (blas.bounds_only)
+            throw Error(strfmt(
+                "mesh %zu has no BLAS (built for its bounds only) but is not left out of the upload", m));
         mesh_vertex_base[m] = uint32_t(out.vertices.size());
         for (size_t v = 0; v < mesh.positions.size(); ++v) {
             GpuVertex g{};

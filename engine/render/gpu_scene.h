@@ -38,6 +38,7 @@ struct GpuSceneData {
     uint32_t outline_shells = 0;                // instances packed as NB_INSTANCE_CAMERA_ONLY
     uint32_t omitted_meshes = 0;                // meshes left out (PackOptions::omit_mesh)
     uint64_t omitted_bytes = 0;                 // their vertices, triangles and BLAS nodes
+    uint32_t omitted_unbuilt = 0;               // of them, meshes whose BLAS was never built (bounds only)
 };
 
 struct PackOptions {
@@ -47,7 +48,8 @@ struct PackOptions {
     uint64_t environment_budget_bytes = UINT64_MAX; // the environment map is halved until its table fits
     // Per Scene::meshes entry (empty: none): not uploaded. Its vertices, triangles and BLAS nodes are left
     // out, its instances point at an empty BLAS and add no light. For meshes only the model answers for
-    // (omitted_neural_meshes).
+    // (omitted_neural_meshes). A mesh whose BLAS is bounds-only (build_scene_accel_bounds_only) must be
+    // omitted: pack_scene throws otherwise.
     std::vector<bool> omit_mesh;
 };
 

@@ -89,10 +89,13 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
     data_ = pack_scene(scene, accel, environment, pack);
     triangles_omitted_ = data_.omitted_meshes > 0;
     if (triangles_omitted_)
-        log_info("render: %u neural mesh%s not uploaded (%.1f MiB of vertices, triangles and BLAS: the model "
+        log_info("render: %u neural mesh%s not uploaded (%.1f MiB of vertices and triangles%s: the model "
                  "answers for them)",
                  data_.omitted_meshes, data_.omitted_meshes == 1 ? "" : "es",
-                 double(data_.omitted_bytes) / double(1 << 20));
+                 double(data_.omitted_bytes) / double(1 << 20),
+                 data_.omitted_unbuilt == data_.omitted_meshes ? ", their BLAS not built"
+                 : data_.omitted_unbuilt == 0                  ? " and their BLAS"
+                                                               : ", the BLAS of those built");
     if (texture_array) {
         texture_array_ = TextureArray(ctx_, scene.textures);
         texture_plan_.bytes = texture_array_.bytes();

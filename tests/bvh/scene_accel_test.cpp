@@ -3,11 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <random>
 
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "engine/bvh/scene_accel.h"
+#include "engine/core/error.h"
 #include "test_geometry.h"
 
 namespace nbvh {
@@ -87,6 +90,89 @@ TEST(SceneAccel, ClosestAndAnyHitMatchBruteForce) {
     }
     EXPECT_GT(hits, 300);
     for (int i = 0; i < 5; ++i) EXPECT_GT(per_instance[i], 0) << "instance " << i << " never hit";
+}
+
+bool same_box(const Aabb& a, const Aabb& b) {
+    return std::memcmp(&a, &b, sizeof(Aabb)) == 0; // bit for bit
+}
+
+// bounds_only_mesh_bvh gives the root box the builder gives, to the bit, on the meshes the builder treats
+// specially: skipped triangles (an index out of range, NaN and infinite vertices), a flat mesh, one far from
+// the origin at float's range, one whose every triangle is skipped.
+TEST(SceneAccel, BoundsOnlyIsTheBuiltRootBox) {
+    std::mt19937 rng(5);
+    std::vector<Mesh> meshes;
+    meshes.push_back(test::make_mesh(test::random_soup(rng, 300, 1.0f, 0.1f)));
+    Mesh bad = test::make_mesh(test::random_soup(rng, 20, 2.0f, 0.3f, glm::vec3(5.0f, 0.0f, 0.0f)));
+    bad.positions[4].y = std::nanf("");                          // triangle 1 skipped
+    bad.positions[9].z = std::numeric_limits<float>::infinity(); // triangle 3 skipped
+    bad.positions[30] = glm::vec3(1.0e6f);                       // triangle 10 out on its own: kept
+    bad.indices[3 * 5 + 1] = 1000u;                              // triangle 5: index out of range
+    meshes.push_back(bad);
+    std::vector<glm::vec3> flat = test::random_soup(rng, 40, 1.0f, 0.2f);
+    for (glm::vec3& p : flat) p.z = 0.25f;
+    meshes.push_back(test::make_mesh(flat));
+    meshes.push_back(
+        test::make_mesh(test::random_soup(rng, 30, 1.0e37f, 1.0e36f, glm::vec3(-2.0e38f, 0.0f, 3.0e38f))));
+    Mesh none = test::make_mesh(test::random_soup(rng, 2, 1.0f, 0.1f));
+    none.positions[0].x = std::nanf("");
+    none.indices[3] = 99u;
+    meshes.push_back(none);
+    meshes.push_back(Mesh{});
+    for (size_t m = 0; m < meshes.size(); ++m) {
+        const MeshBvh built = build_mesh_bvh(meshes[m]), only = bounds_only_mesh_bvh(meshes[m]);
+        EXPECT_TRUE(only.bounds_only);
+        EXPECT_FALSE(built.bounds_only);
+        EXPECT_EQ(only.empty(), built.empty()) << "mesh " << m;
+        EXPECT_TRUE(same_box(only.bounds(), built.bounds())) << "mesh " << m;
+        EXPECT_TRUE(only.vertices.empty());
+    }
+    EXPECT_TRUE(bounds_only_mesh_bvh(meshes[4]).empty()) << "every triangle skipped";
+    EXPECT_EQ(bounds_only_mesh_bvh(meshes[1]).bounds().hi, glm::vec3(1.0e6f)) << "the lone far vertex counts";
+    Hit h;
+    const MeshBvh only = bounds_only_mesh_bvh(meshes[0]);
+    EXPECT_THROW(
+        intersect_closest(only, Ray{glm::vec3(0.0f, 0.0f, -5.0f), glm::vec3(0, 0, 1)}, 0.0f, NB_INF, h),
+        Error);
+    EXPECT_THROW(intersect_any(only, Ray{glm::vec3(0.0f, 0.0f, -5.0f), glm::vec3(0, 0, 1)}, 0.0f, NB_INF),
+                 Error);
+}
+
+// A scene with some meshes bounds-only has the TLAS of the full build; a ray that reaches such a mesh
+// throws, one that reaches only built meshes is answered as before.
+TEST(SceneAccel, BoundsOnlyMeshesKeepTheTlas) {
+    std::mt19937 rng(6);
+    const Scene s = make_scene(rng);
+    const SceneAccel full = build_scene_accel(s);
+    const SceneAccel part = build_scene_accel_bounds_only(s, {false, true, true});
+    ASSERT_EQ(part.meshes.size(), 3u);
+    EXPECT_FALSE(part.meshes[0].bounds_only);
+    EXPECT_TRUE(part.meshes[1].bounds_only && part.meshes[2].bounds_only);
+    EXPECT_EQ(part.tlas.prim_indices, full.tlas.prim_indices);
+    ASSERT_EQ(part.tlas.nodes.size(), full.tlas.nodes.size());
+    for (size_t n = 0; n < full.tlas.nodes.size(); ++n) {
+        EXPECT_TRUE(same_box(part.tlas.nodes[n].bounds, full.tlas.nodes[n].bounds)) << "node " << n;
+        EXPECT_EQ(part.tlas.nodes[n].count, full.tlas.nodes[n].count);
+        EXPECT_EQ(part.tlas.nodes[n].first, full.tlas.nodes[n].first);
+    }
+    for (size_t i = 0; i < s.instances.size(); ++i)
+        EXPECT_TRUE(same_box(part.instance_bounds[i], full.instance_bounds[i])) << "instance " << i;
+    // Instance 3 (mesh 1) is alone around (0, 3, 1); instance 0 (mesh 0) at the origin, where instance 4
+    // (mesh 1) overlaps it.
+    SceneHit h;
+    EXPECT_THROW(
+        intersect_closest(part, Ray{glm::vec3(0.0f, 3.0f, -10.0f), glm::vec3(0, 0, 1)}, 0.0f, NB_INF, h),
+        Error);
+    const SceneAccel mesh0 = build_scene_accel_bounds_only(s, {true});
+    EXPECT_THROW(intersect_any(mesh0, Ray{glm::vec3(0.0f, 0.0f, -10.0f), glm::vec3(0, 0, 1)}, 0.0f, NB_INF),
+                 Error);
+    const SceneAccel mesh1 = build_scene_accel_bounds_only(s, {false, true});
+    const Ray far_side{glm::vec3(3.0f, 0.0f, -10.0f), glm::vec3(0, 0, 1)}; // through instance 1 only
+    SceneHit a, b;
+    ASSERT_EQ(intersect_closest(mesh1, far_side, 0.0f, NB_INF, a),
+              intersect_closest(full, far_side, 0.0f, NB_INF, b));
+    EXPECT_EQ(a.t, b.t);
+    EXPECT_TRUE(build_scene_accel_bounds_only(s, {}).meshes[0].bvh.nodes.size() > 1) << "no flags: all built";
 }
 
 TEST(SceneAccel, EmptyScene) {

@@ -277,6 +277,18 @@ TEST(HybridRender, OmittedNeuralTrianglesKeepTheImage) {
     lean_classical.neural.classical = true;
     EXPECT_FALSE(lean.apply(lean_classical)) << "no triangles to switch to: a new renderer is needed";
     EXPECT_TRUE(keep.apply(classical));
+    // What `nbvh render --model` builds: the omitted mesh's BLAS never built, its bounds only. The same
+    // TLAS, the same image.
+    const SceneAccel bounds = build_scene_accel_bounds_only(f.scene, omitted_neural_meshes(f.scene));
+    ASSERT_TRUE(bounds.meshes[0].bounds_only);
+    WavefrontRenderer unbuilt(ctx, f.scene, bounds, default_sky(), cam, lean_o);
+    EXPECT_EQ(unbuilt.scene_data().omitted_unbuilt, 1u);
+    EXPECT_EQ(unbuilt.scene_data().tlas_nodes.size(), lean.scene_data().tlas_nodes.size());
+    const RenderResult c = unbuilt.render();
+    EXPECT_EQ(c.stats.neural_queries, b.stats.neural_queries);
+    EXPECT_EQ(c.image.data, b.image.data);
+    // A renderer that would upload the mesh cannot take the bounds-only BLAS.
+    EXPECT_THROW(WavefrontRenderer(ctx, f.scene, bounds, default_sky(), cam, o), Error);
     EXPECT_EQ(ctx.validation_message_count(), 0);
 }
 
