@@ -1,5 +1,5 @@
 // nbvh view SCENE [--model M.nbvh] [--env FILE|none] [--width W --height H] [--device auto|gpu|cpu]
-//                 [--max-depth D] [--lod L] [--secondary-lod coarsest|same|L] [--neural GLOB]
+//                 [--max-depth D] [--lod L] [--secondary-lod coarsest|same|L] [--neural GLOB] [--subdivide L]
 //                 [--screenshot FILE.png] [--frames N] [--hide-ui] [--script FILE]
 // The interactive viewer (app/viewer/): progressive path tracing in a window with a UI panel.
 // --frames N exits after N frames (headless tests under Xvfb); --screenshot saves the window then;
@@ -22,6 +22,7 @@ void add_view_command(CLI::App& app) {
                     "environment map (.hdr or .exr, equirectangular), or 'none' (the scene's lights only); default: "
                     "the scene's, else the default sky (as nbvh render)");
     cmd->add_option("--neural", args->neural_glob, "nodes whose name matches this glob are neural instances");
+    add_subdivide_option(cmd, args->subdivide);
     cmd->add_option("--width", args->width, "window width in pixels")->check(CLI::Range(16u, 16384u));
     cmd->add_option("--height", args->height, "window height in pixels")->check(CLI::Range(16u, 16384u));
     cmd->add_option("--device", args->device,

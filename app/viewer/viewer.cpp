@@ -30,6 +30,7 @@ void run_viewer(const ViewerArgs& a) {
     SceneOptions so;
     so.neural_glob = a.neural_glob;
     so.env = a.env;
+    so.subdivide = a.subdivide;
     uint32_t fb_w = 0, fb_h = 0;
     window.framebuffer_size(&fb_w, &fb_h);
     const uint32_t width = fb_w ? fb_w : a.width, height = fb_h ? fb_h : a.height;

@@ -14,6 +14,7 @@ struct ViewerArgs {
     std::string model;            // .nbvh for the scene's neural instances (hybrid render)
     std::string env;              // --env FILE | none | "" (app/render_args.h choose_environment)
     std::string neural_glob;      // nodes whose name matches are neural instances
+    uint32_t subdivide = 0;       // --subdivide L (engine/scene/subdivide.h), as for nbvh render
     std::string device = "auto";  // auto | gpu | cpu
     uint32_t width = 1280, height = 720; // window (and initial film) size
     uint32_t max_depth = 8;

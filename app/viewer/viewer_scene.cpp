@@ -29,8 +29,10 @@ std::unique_ptr<ViewerScene> load_viewer_scene(const std::string& source, const 
     v->model = std::move(model);
     SceneLoadOptions lo;
     lo.neural_glob = options.neural_glob;
+    lo.subdivide = options.subdivide;
     // With a model its asset table decides which instances are neural (the --neural glob is ignored).
-    v->scene = app::load_scene_for_model(source, v->model ? SceneLoadOptions{} : lo, v->model.get(), model_name);
+    if (v->model) lo.neural_glob.clear();
+    v->scene = app::load_scene_for_model(source, lo, v->model.get(), model_name);
     v->env = app::choose_environment(v->scene, options.env);
     v->home = v->scene.has_camera ? v->scene.camera : auto_frame(v->scene, aspect);
     const auto t0 = std::chrono::steady_clock::now();

@@ -35,6 +35,7 @@ struct ViewerScene {
 struct SceneOptions {
     std::string neural_glob; // --neural: nodes whose name matches are neural (without a model)
     std::string env;         // --env FILE | none | "" (app/render_args.h choose_environment)
+    uint32_t subdivide = 0;  // --subdivide L: every mesh split L times (a model needs its training's L)
 };
 
 // Loads `source` ("default" or glTF), binds `model` to it when given (engine/neural/asset_table.h:

@@ -78,6 +78,35 @@ TEST(ViewerCli, EnvNoneKeepsOnlyTheScenesLights) {
     EXPECT_EQ(top_row_luminance(" --env none", "none"), 0.0) << "no environment: a black background";
 }
 
+// --subdivide L as for nbvh render: a model trained on the subdivided scene is shown with the same L (the
+// view's scene has 4^L times the triangles) and refused without it, one line naming the option.
+TEST(ViewerCli, SubdivideAsForRender) {
+    if (!have_xvfb_run()) GTEST_SKIP() << "xvfb-run not installed (Debian: xvfb)";
+    const std::filesystem::path dir = test::temp_dir("viewer_subdivide");
+    const std::filesystem::path model = dir / "m.nbvh", png = dir / "out.png", log = dir / "log.txt";
+    ASSERT_EQ(run(std::string(NBVH_EXE) +
+                  " train default --backend cpu --steps 2 --batch 64 --nodes 8 --lods 1 " +
+                  "--subdivide 1 --out " + model.string() + " > " + log.string() + " 2>&1"),
+              0)
+        << read_file(log);
+    const std::string view =
+        "xvfb-run -a " + std::string(NBVH_EXE) + " view default --device cpu --width 64 " +
+        "--height 36 --frames 1 --hide-ui --model " + model.string() + " --screenshot " + png.string();
+    EXPECT_NE(run(view + " > " + log.string() + " 2>&1"), 0);
+    std::string text = read_file(log);
+    EXPECT_NE(text.find("nbvh: error:"), std::string::npos) << text;
+    EXPECT_NE(text.find("--subdivide"), std::string::npos) << text;
+    EXPECT_FALSE(std::filesystem::exists(png));
+    ASSERT_EQ(run(view + " --subdivide 1 > " + log.string() + " 2>&1"), 0) << read_file(log);
+    text = read_file(log);
+    EXPECT_NE(text.find("--subdivide 1:"), std::string::npos) << "the subdivision's log line: " << text;
+    EXPECT_TRUE(std::filesystem::exists(png)) << text;
+    EXPECT_NE(run("env -u DISPLAY " + std::string(NBVH_EXE) + " view default --subdivide 5 > " +
+                  log.string() + " 2>&1"),
+              0);
+    EXPECT_NE(read_file(log).find("--subdivide"), std::string::npos) << read_file(log);
+}
+
 TEST(ViewerCli, NoDisplayIsOneClearLine) {
     const std::filesystem::path dir = test::temp_dir("viewer_no_display");
     const std::filesystem::path log = dir / "log.txt";
