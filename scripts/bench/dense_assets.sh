@@ -8,6 +8,8 @@
 #     rounds, the fastest of each; GPU timestamps), each after two untimed renders of the same image in its process
 #     (`--warmup 2`: the GPU idles through a large scene's BVH build and starts the next frame at low
 #     clocks; separate warm-up processes do not help there);
+#   - the wall time of each of those `nbvh render` processes (load, subdivision, BVH builds, pipelines,
+#     the warm-ups and the frame: what a user waits for one image) and its "BVHs built in" time;
 #   - at FLIP_W x FLIP_H (960x540), FLIP_SPP (2048) spp: a classical reference of seed 7, the classical
 #     render of seed 0 (the noise floor) and the hybrid of seed 0, LDR-FLIP of both against the reference.
 # Usage (GPU machine, after `source .device/env.sh`): SCENES="dragon default" LEVELS="0 1 2" \
@@ -34,28 +36,42 @@ for train in sorted(glob.glob(os.path.join(t, "*.train.json"))):
     scene, level = os.path.basename(p).rsplit("_", 1)
     side = {}
     for s in ("classical", "hybrid"):
-        runs = [json.load(open(f)) for f in sorted(glob.glob(f"{p}.{s}_*.json"))]
+        files = sorted(glob.glob(f"{p}.{s}_*.json"))
+        runs = [json.load(open(f)) for f in files]
         best = min(runs, key=lambda j: j["gpu_total_ms"])
         spp = best["spp"]
+        walls = [num(f[: -len(".json")] + ".wall") for f in files]
+        bvh = [float(m.group(1)) for f in files
+               for m in [re.search(r"BVHs built in ([0-9.]+) ms", open(f[: -len(".json")] + ".log").read())] if m]
         side[s] = {"ms_per_spp": best["gpu_total_ms"] / spp, "all_ms_per_spp": [j["gpu_total_ms"] / spp for j in runs],
                    "rays_per_second": best["rays_per_second"], "neural": best.get("neural"),
                    "passes_ms_per_spp": {k.split("/")[-1].replace(".comp", ""): v / spp for k, v in best["pass_gpu_ms"].items()},
-                   "device": best["device"], "driver": best["driver"], "commit": best["commit"]}
+                   "device": best["device"], "driver": best["driver"], "commit": best["commit"],
+                   "wall_s": min(walls), "all_wall_s": walls, "bvh_build_ms": min(bvh) if bvh else None}
     log = open(os.path.join(os.path.dirname(out), f"train_{scene}_{level}.log")).read()
     tri = re.search(r"training .*?\((\d+) triangles\)", log)
     rows.append({"scene": scene, "subdivide": int(level), "asset_triangles": int(tri.group(1)) if tri else None,
                  "train_wall_s": json.load(open(train))["train_wall_s"],
                  "classical": side["classical"], "hybrid": side["hybrid"],
                  "hybrid_over_classical": side["hybrid"]["ms_per_spp"] / side["classical"]["ms_per_spp"],
+                 "hybrid_over_classical_wall": side["hybrid"]["wall_s"] / side["classical"]["wall_s"],
                  "flip_hybrid_vs_ref": num(p + ".flip_hybrid.txt"), "flip_floor": num(p + ".flip_floor.txt")})
 json.dump({"binary": sys.argv[3], "rows": rows}, open(out, "w"), indent=1)
-print("%-8s %2s %11s %12s %12s %7s %9s %8s %8s" % ("scene", "L", "triangles", "classical", "hybrid", "ratio",
-                                                  "train s", "FLIP", "floor"))
+print("%-8s %2s %11s %12s %12s %7s %9s %8s %8s %17s" % ("scene", "L", "triangles", "classical", "hybrid", "ratio",
+                                                       "train s", "FLIP", "floor", "render wall c/h s"))
 for r in rows:
-    print("%-8s %2d %11s %9.3f ms %9.3f ms %6.2fx %9.1f %8.4f %8.4f" % (
+    print("%-8s %2d %11s %9.3f ms %9.3f ms %6.2fx %9.1f %8.4f %8.4f %8.1f / %6.1f" % (
         r["scene"], r["subdivide"], r["asset_triangles"], r["classical"]["ms_per_spp"], r["hybrid"]["ms_per_spp"],
-        r["hybrid_over_classical"], r["train_wall_s"], r["flip_hybrid_vs_ref"], r["flip_floor"]))
+        r["hybrid_over_classical"], r["train_wall_s"], r["flip_hybrid_vs_ref"], r["flip_floor"],
+        r["classical"]["wall_s"], r["hybrid"]["wall_s"]))
 PY
+}
+timed() { # SIDE REP ARGS...: one render of level P, its stats, log and wall seconds
+  local f=$P.$1_$2 s
+  shift 2
+  s=$(date +%s.%N)
+  "$B" render "$@" "${R[@]}" --stats "$f.json" > "$f.log" 2>&1
+  python3 -c "import sys; print(float(sys.argv[2]) - float(sys.argv[1]))" "$s" "$(date +%s.%N)" > "$f.wall"
 }
 # shellcheck disable=SC2206
 TA=(${TRAIN_ARGS:-})
@@ -71,8 +87,8 @@ for scene in ${SCENES:-dragon default}; do
     C=("${SRC[@]}" "${NEURAL[@]}" --classical "${VIEW[@]}" "${D[@]}")
     H=("${SRC[@]}" --model "$P.nbvh" "${VIEW[@]}" "${D[@]}")
     for rep in $(seq "${REPS:-2}"); do
-      "$B" render "${C[@]}" "${R[@]}" --out "$T/c.png" --stats "$P.classical_$rep.json" > /dev/null 2>&1
-      "$B" render "${H[@]}" "${R[@]}" --out "$T/h.png" --stats "$P.hybrid_$rep.json" > /dev/null 2>&1
+      timed classical "$rep" "${C[@]}" --out "$T/c.png"
+      timed hybrid "$rep" "${H[@]}" --out "$T/h.png"
     done
     "$B" render "${C[@]}" "${F[@]}" --seed 7 --out "$P.ref.png" > /dev/null 2>&1
     "$B" render "${C[@]}" "${F[@]}" --out "$P.cl.png" > /dev/null 2>&1

@@ -39,6 +39,10 @@ for r in rows:
     for k in ("hybrid_over_classical", "flip_hybrid_vs_ref", "flip_floor"):
         assert math.isfinite(r[k]) and r[k] >= 0, (k, r[k])
     assert r["classical"]["ms_per_spp"] > 0 and r["hybrid"]["neural"]["queries"] > 0, r
+    for side in ("classical", "hybrid"):  # wall times of the renders, their BVH build times from the logs
+        assert r[side]["wall_s"] > 0 and len(r[side]["all_wall_s"]) == 1 and r[side]["bvh_build_ms"] >= 0, r[side]
 print("dense_assets.sh dry run:", [(r["subdivide"], r["asset_triangles"], round(r["hybrid_over_classical"], 2)) for r in rows])
 PY
+grep -q "BVHs built in .* (the neural-only meshes' bounds only" "$W/nbvh_dense/default_1.hybrid_1.log" \
+  || { echo "the hybrid render built the neural asset's BLAS"; cat "$W/nbvh_dense/default_1.hybrid_1.log"; exit 1; }
 echo "ok"
