@@ -5,16 +5,17 @@
 # paper's Statuette). One binary, one GPU call. Per scene and level:
 #   - a model trained by `nbvh train --subdivide L` with no other flag (its wall time recorded);
 #   - 1920x1080, SPP (16) spp, max depth 8, render defaults: classical, hybrid, classical, hybrid (REPS
-#     rounds, the fastest of each; GPU timestamps), each after two untimed renders of the same image in its process
-#     (`--warmup 2`: the GPU idles through a large scene's BVH build and starts the next frame at low
-#     clocks; separate warm-up processes do not help there);
-#   - the wall time of each of those `nbvh render` processes (load, subdivision, BVH builds, pipelines,
-#     the warm-ups and the frame: what a user waits for one image) and its "BVHs built in" time;
+#     rounds, the fastest of each; GPU timestamps), each after WARMUP (30) untimed renders of the same image
+#     in its process (`--warmup 30`, ~0.6-1.2 s of GPU work: the GPU idles through a large scene's BVH
+#     build and starts the next frame at low clocks; separate warm-up processes do not help there, and
+#     two warm-up renders left both classical renders of the dragon at level 1 3-4x slow in one call);
+#   - then one more render per side without warm-up: its wall time (load, subdivision, BVH builds,
+#     pipelines, the frame, the PNG: what a user waits for one image) and its "BVHs built in" time;
 #   - at FLIP_W x FLIP_H (960x540), FLIP_SPP (2048) spp: a classical reference of seed 7, the classical
 #     render of seed 0 (the noise floor) and the hybrid of seed 0, LDR-FLIP of both against the reference.
 # Usage (GPU machine, after `source .device/env.sh`): SCENES="dragon default" LEVELS="0 1 2" \
 #   scripts/bench/dense_assets.sh OUT     (NBVH: the binary, default .device/study/bin/nbvh)
-# Env also: WIDTH, HEIGHT (1920x1080), REPS (timed renders per side, 2), TRAIN_ARGS (extra `nbvh train` flags; CI's dry run trains tiny CPU
+# Env also: WIDTH, HEIGHT (1920x1080), REPS (timed renders per side, 2), WARMUP (30), TRAIN_ARGS (extra `nbvh train` flags; CI's dry run trains tiny CPU
 # models with them, tests/bench/bench_scripts_dry_run.sh).
 # Writes OUT/dense.json (every row), OUT/train_SCENE_L.log, OUT/device.txt; prints a table.
 set -euo pipefail
@@ -23,7 +24,7 @@ source scripts/bench/lib.sh
 OUT=$1
 bench_setup "$OUT" dense
 rm -f "$T"/*.train.json # rows of an earlier call on a warm machine
-R=(--width "${WIDTH:-1920}" --height "${HEIGHT:-1080}" --max-depth 8 --exposure 0 --spp "${SPP:-16}" --warmup 2)
+R=(--width "${WIDTH:-1920}" --height "${HEIGHT:-1080}" --max-depth 8 --exposure 0 --spp "${SPP:-16}")
 F=(--width "${FLIP_W:-960}" --height "${FLIP_H:-540}" --max-depth 8 --exposure 0 --spp "${FLIP_SPP:-2048}")
 summarize() { # OUT/dense.json from every level done so far (a call cut short keeps its finished rows)
 python3 - "$T" "$OUT/dense.json" "$B" <<'PY'
@@ -36,18 +37,15 @@ for train in sorted(glob.glob(os.path.join(t, "*.train.json"))):
     scene, level = os.path.basename(p).rsplit("_", 1)
     side = {}
     for s in ("classical", "hybrid"):
-        files = sorted(glob.glob(f"{p}.{s}_*.json"))
-        runs = [json.load(open(f)) for f in files]
+        runs = [json.load(open(f)) for f in sorted(glob.glob(f"{p}.{s}_[0-9]*.json"))]
         best = min(runs, key=lambda j: j["gpu_total_ms"])
         spp = best["spp"]
-        walls = [num(f[: -len(".json")] + ".wall") for f in files]
-        bvh = [float(m.group(1)) for f in files
-               for m in [re.search(r"BVHs built in ([0-9.]+) ms", open(f[: -len(".json")] + ".log").read())] if m]
+        bvh = re.search(r"BVHs built in ([0-9.]+) ms", open(f"{p}.{s}_wall.log").read())
         side[s] = {"ms_per_spp": best["gpu_total_ms"] / spp, "all_ms_per_spp": [j["gpu_total_ms"] / spp for j in runs],
                    "rays_per_second": best["rays_per_second"], "neural": best.get("neural"),
                    "passes_ms_per_spp": {k.split("/")[-1].replace(".comp", ""): v / spp for k, v in best["pass_gpu_ms"].items()},
                    "device": best["device"], "driver": best["driver"], "commit": best["commit"],
-                   "wall_s": min(walls), "all_wall_s": walls, "bvh_build_ms": min(bvh) if bvh else None}
+                   "wall_s": num(f"{p}.{s}_wall.wall"), "bvh_build_ms": float(bvh.group(1)) if bvh else None}
     log = open(os.path.join(os.path.dirname(out), f"train_{scene}_{level}.log")).read()
     tri = re.search(r"training .*?\((\d+) triangles\)", log)
     rows.append({"scene": scene, "subdivide": int(level), "asset_triangles": int(tri.group(1)) if tri else None,
@@ -66,11 +64,11 @@ for r in rows:
         r["classical"]["wall_s"], r["hybrid"]["wall_s"]))
 PY
 }
-timed() { # SIDE REP ARGS...: one render of level P, its stats, log and wall seconds
-  local f=$P.$1_$2 s
-  shift 2
+timed() { # SIDE REP WARMUP ARGS...: one render of level P, its stats, log and wall seconds
+  local f=$P.$1_$2 w=$3 s
+  shift 3
   s=$(date +%s.%N)
-  "$B" render "$@" "${R[@]}" --stats "$f.json" > "$f.log" 2>&1
+  "$B" render "$@" "${R[@]}" --warmup "$w" --stats "$f.json" > "$f.log" 2>&1
   python3 -c "import sys; print(float(sys.argv[2]) - float(sys.argv[1]))" "$s" "$(date +%s.%N)" > "$f.wall"
 }
 # shellcheck disable=SC2206
@@ -87,9 +85,11 @@ for scene in ${SCENES:-dragon default}; do
     C=("${SRC[@]}" "${NEURAL[@]}" --classical "${VIEW[@]}" "${D[@]}")
     H=("${SRC[@]}" --model "$P.nbvh" "${VIEW[@]}" "${D[@]}")
     for rep in $(seq "${REPS:-2}"); do
-      timed classical "$rep" "${C[@]}" --out "$T/c.png"
-      timed hybrid "$rep" "${H[@]}" --out "$T/h.png"
+      timed classical "$rep" "${WARMUP:-30}" "${C[@]}" --out "$T/c.png"
+      timed hybrid "$rep" "${WARMUP:-30}" "${H[@]}" --out "$T/h.png"
     done
+    timed classical wall 0 "${C[@]}" --out "$T/c.png"
+    timed hybrid wall 0 "${H[@]}" --out "$T/h.png"
     "$B" render "${C[@]}" "${F[@]}" --seed 7 --out "$P.ref.png" > /dev/null 2>&1
     "$B" render "${C[@]}" "${F[@]}" --out "$P.cl.png" > /dev/null 2>&1
     "$B" render "${H[@]}" "${F[@]}" --out "$P.hy.png" > /dev/null 2>&1
