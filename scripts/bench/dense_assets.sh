@@ -5,8 +5,8 @@
 # paper's Statuette). One binary, one GPU call. Per scene and level:
 #   - a model trained by `nbvh train --subdivide L` with no other flag (its wall time recorded);
 #   - 1920x1080, SPP (16) spp, max depth 8, render defaults: classical, hybrid, classical, hybrid (REPS
-#     rounds, the fastest of each; GPU timestamps), each after WARMUP (30) untimed renders of the same image
-#     in its process (`--warmup 30`, ~0.6-1.2 s of GPU work: the GPU idles through a large scene's BVH
+#     rounds, the fastest of each; GPU timestamps), each after WARMUP (16, the most nbvh render takes) untimed renders of the same image
+#     in its process (`--warmup 16`, ~0.3-0.6 s of GPU work: the GPU idles through a large scene's BVH
 #     build and starts the next frame at low clocks; separate warm-up processes do not help there, and
 #     two warm-up renders left both classical renders of the dragon at level 1 3-4x slow in one call);
 #   - then one more render per side without warm-up: its wall time (load, subdivision, BVH builds,
@@ -15,7 +15,7 @@
 #     render of seed 0 (the noise floor) and the hybrid of seed 0, LDR-FLIP of both against the reference.
 # Usage (GPU machine, after `source .device/env.sh`): SCENES="dragon default" LEVELS="0 1 2" \
 #   scripts/bench/dense_assets.sh OUT     (NBVH: the binary, default .device/study/bin/nbvh)
-# Env also: WIDTH, HEIGHT (1920x1080), REPS (timed renders per side, 2), WARMUP (30), TRAIN_ARGS (extra `nbvh train` flags; CI's dry run trains tiny CPU
+# Env also: WIDTH, HEIGHT (1920x1080), REPS (timed renders per side, 2), WARMUP (16, the most nbvh render takes), TRAIN_ARGS (extra `nbvh train` flags; CI's dry run trains tiny CPU
 # models with them, tests/bench/bench_scripts_dry_run.sh).
 # Writes OUT/dense.json (every row), OUT/train_SCENE_L.log, OUT/device.txt; prints a table.
 set -euo pipefail
@@ -68,7 +68,7 @@ timed() { # SIDE REP WARMUP ARGS...: one render of level P, its stats, log and w
   local f=$P.$1_$2 w=$3 s
   shift 3
   s=$(date +%s.%N)
-  "$B" render "$@" "${R[@]}" --warmup "$w" --stats "$f.json" > "$f.log" 2>&1
+  "$B" render "$@" "${R[@]}" --warmup "$w" --stats "$f.json" > "$f.log" 2>&1 || { tail -3 "$f.log"; exit 1; }
   python3 -c "import sys; print(float(sys.argv[2]) - float(sys.argv[1]))" "$s" "$(date +%s.%N)" > "$f.wall"
 }
 # shellcheck disable=SC2206
@@ -85,8 +85,8 @@ for scene in ${SCENES:-dragon default}; do
     C=("${SRC[@]}" "${NEURAL[@]}" --classical "${VIEW[@]}" "${D[@]}")
     H=("${SRC[@]}" --model "$P.nbvh" "${VIEW[@]}" "${D[@]}")
     for rep in $(seq "${REPS:-2}"); do
-      timed classical "$rep" "${WARMUP:-30}" "${C[@]}" --out "$T/c.png"
-      timed hybrid "$rep" "${WARMUP:-30}" "${H[@]}" --out "$T/h.png"
+      timed classical "$rep" "${WARMUP:-16}" "${C[@]}" --out "$T/c.png"
+      timed hybrid "$rep" "${WARMUP:-16}" "${H[@]}" --out "$T/h.png"
     done
     timed classical wall 0 "${C[@]}" --out "$T/c.png"
     timed hybrid wall 0 "${H[@]}" --out "$T/h.png"
