@@ -36,6 +36,9 @@ struct BvhBuildOptions {
     // base BVH uses BBOX_REGULARISATION = 1e-4, official notes §1); parents are regrown to contain
     // their padded children. 0 keeps exact bounds (triangle BLAS/TLAS).
     float min_node_extent = 0.0f;
+    // Threads that build subtrees at once (0: every core). Any count gives the same Bvh, node for node:
+    // each subtree is built as the one-thread build would and placed where it would place it.
+    uint32_t threads = 0;
 };
 
 // Binned SAH build over primitive bounds. Primitives with empty or non-finite bounds are left out

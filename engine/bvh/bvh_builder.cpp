@@ -1,5 +1,6 @@
 // Binned SAH BVH builder (Wald 2007 "On fast construction of SAH-based BVHs"; madmann91/bvh's
-// binned builder for the structure). Single-threaded, iterative (explicit work stack), top-down.
+// binned builder for the structure). Iterative (explicit work stack), top-down; large subtrees are built
+// on several threads (build_parallel), each as the one-thread build builds it, and laid out in its order.
 //
 // Robustness rules (issue 2 item 4):
 //  - primitives with empty or non-finite bounds are skipped;
@@ -11,7 +12,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <future>
 #include <limits>
+#include <memory>
+#include <thread>
 
 #include "engine/bvh/aabb_ops.h"
 #include "engine/bvh/bvh.h"
@@ -23,6 +27,8 @@ namespace {
 constexpr uint32_t MAX_BINS = 256;
 constexpr uint32_t DEPTH_LIMIT = NB_BVH_MAX_DEPTH - 1; // deepest allowed node depth (root = 0)
 constexpr uint64_t MAX_PRIMS = uint64_t(1) << NB_LEAF_FIRST_BITS;
+constexpr uint32_t PARALLEL_MIN_PRIMS = 1u
+                                        << 14; // smaller subtrees are built on the thread that reaches them
 
 struct Bin {
     Aabb bounds;
@@ -53,37 +59,91 @@ public:
         traversal_cost_ = std::isfinite(o.traversal_cost) ? std::max(o.traversal_cost, 0.0f) : 1.0f;
     }
 
-    Bvh build() {
+    Bvh build(uint32_t threads) {
         Bvh bvh;
-        centroids_.resize(bounds_.size());
+        centroids_ = std::make_shared<std::vector<glm::vec3>>(bounds_.size());
+        std::vector<glm::vec3>& centroids = *centroids_;
         for (uint32_t i = 0; i < bounds_.size(); ++i) {
             if (!is_valid(bounds_[i])) continue;
             // Centre computed in double so that huge (finite) bounds do not overflow.
             glm::dvec3 c = 0.5 * (glm::dvec3(bounds_[i].lo) + glm::dvec3(bounds_[i].hi));
-            centroids_[i] = glm::vec3(c);
+            centroids[i] = glm::vec3(c);
             bvh.prim_indices.push_back(i);
         }
         if (bvh.prim_indices.empty()) return bvh;
         if (bvh.prim_indices.size() > MAX_PRIMS)
             throw Error("BVH: too many primitives (" + std::to_string(bvh.prim_indices.size()) + ", at most 2^27)");
         idx_ = bvh.prim_indices.data();
-        nodes_ = &bvh.nodes;
-        nodes_->reserve(2 * bvh.prim_indices.size());
-
         BvhNode root;
         root.first = 0;
         root.count = uint32_t(bvh.prim_indices.size());
-        nodes_->push_back(root);
+        if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+        // Subtrees are handed to other threads down to the level where there are about 2 per thread.
+        uint32_t spawn_levels = 0;
+        while (threads > 1 && (1u << spawn_levels) < 2 * threads && spawn_levels < 8) ++spawn_levels;
+        bvh.nodes = build_parallel(root, spawn_levels);
+        return bvh;
+    }
+
+  private:
+    // The subtree of `root` (first, count and depth set) as the one-thread build lays it out with root at
+    // index 0: the root, its two children, the right child's descendants, then the left child's (the
+    // work stack pops the right child first). Indices (children, parents) are local to the vector.
+    std::vector<BvhNode> build_sequential(const BvhNode& root) {
+        std::vector<BvhNode> nodes;
+        nodes.reserve(2 * size_t(root.count));
+        nodes_ = &nodes;
+        nodes.push_back(root);
         std::vector<uint32_t> stack{0};
         while (!stack.empty()) {
             uint32_t ni = stack.back();
             stack.pop_back();
             if (subdivide(ni)) {
-                stack.push_back((*nodes_)[ni].left);
-                stack.push_back((*nodes_)[ni].right);
+                stack.push_back(nodes[ni].left);
+                stack.push_back(nodes[ni].right);
             }
         }
-        return bvh;
+        nodes_ = nullptr;
+        return nodes;
+    }
+
+    // The same layout, with the left child's subtree built on another thread while this one builds the
+    // right child's, down `levels` levels. The split of a node depends only on its primitives and their
+    // order in idx_, which the children's builds (disjoint ranges) do not touch: the same tree.
+    std::vector<BvhNode> build_parallel(const BvhNode& root, uint32_t levels) {
+        if (levels == 0 || root.count < PARALLEL_MIN_PRIMS) return build_sequential(root);
+        std::vector<BvhNode> one{root};
+        nodes_ = &one;
+        const bool split = subdivide(0);
+        nodes_ = nullptr;
+        if (!split) return one;
+        const BvhNode node = one[0], left = one[1], right = one[2];
+        Builder other(*this); // its own bins; the same bounds, centroids and index array
+        std::future<std::vector<BvhNode>> fl = std::async(
+            std::launch::async, [&other, &left, levels] { return other.build_parallel(left, levels - 1); });
+        std::vector<BvhNode> r = build_parallel(right, levels - 1);
+        std::vector<BvhNode> l = fl.get();
+        // [node, left, right] + the right subtree's descendants + the left subtree's.
+        const uint32_t r_base = 2,
+                       l_base = uint32_t(r.size()) + 1; // where local index 1.. of each goes, minus 1
+        std::vector<BvhNode> out;
+        out.reserve(1 + r.size() + l.size());
+        out.push_back(node);
+        auto place = [&out](BvhNode n, uint32_t self, uint32_t base) { // local index k >= 1 -> base + k
+            auto map = [&](uint32_t k) { return k == BVH_INVALID ? k : k == 0 ? self : base + k; };
+            n.left = map(n.left);
+            n.right = map(n.right);
+            n.parent = map(n.parent);
+            out.push_back(n);
+        };
+        BvhNode lr = l[0], rr = r[0];
+        place(lr, 1, l_base);
+        out.back().parent = 0;
+        place(rr, 2, r_base);
+        out.back().parent = 0;
+        for (size_t k = 1; k < r.size(); ++k) place(r[k], 2, r_base);
+        for (size_t k = 1; k < l.size(); ++k) place(l[k], 1, l_base);
+        return out;
     }
 
 private:
@@ -95,7 +155,7 @@ private:
         Aabb nb, cb;
         for (uint32_t i = first; i < first + count; ++i) {
             nb.grow(bounds_[idx_[i]]);
-            cb.grow(centroids_[idx_[i]]);
+            cb.grow((*centroids_)[idx_[i]]);
         }
         node.bounds = nb;
         if (count == 1) return false;
@@ -167,7 +227,7 @@ private:
         // One pass over the primitives fills the bins of all three axes.
         for (uint32_t i = first; i < first + count; ++i) {
             const uint32_t p = idx_[i];
-            const glm::vec3& c = centroids_[p];
+            const glm::vec3& c = (*centroids_)[p];
             const Aabb& pb = bounds_[p];
             for (int axis = 0; axis < 3; ++axis) {
                 if (scale[axis] == 0.0f) continue;
@@ -207,7 +267,7 @@ private:
         const float scale = bin_scale(cb, s.axis);
         const float lo = cb.lo[s.axis];
         uint32_t* mid = std::partition(idx_ + first, idx_ + first + count, [&](uint32_t p) {
-            return bin_of(centroids_[p], s.axis, lo, scale) < s.bin;
+            return bin_of((*centroids_)[p], s.axis, lo, scale) < s.bin;
         });
         return uint32_t(mid - idx_);
     }
@@ -218,14 +278,15 @@ private:
         glm::vec3 e = cb.extent();
         int axis = (e.x >= e.y && e.x >= e.z) ? 0 : (e.y >= e.z ? 1 : 2);
         if (e[axis] > 0.0f) {
-            std::nth_element(idx_ + first, idx_ + mid, idx_ + first + count,
-                             [&](uint32_t a, uint32_t b) { return centroids_[a][axis] < centroids_[b][axis]; });
+            std::nth_element(idx_ + first, idx_ + mid, idx_ + first + count, [&](uint32_t a, uint32_t b) {
+                return (*centroids_)[a][axis] < (*centroids_)[b][axis];
+            });
         }
         return mid;
     }
 
     std::span<const Aabb> bounds_;
-    std::vector<glm::vec3> centroids_;
+    std::shared_ptr<std::vector<glm::vec3>> centroids_; // shared, read-only, by the builders of one build
     std::array<std::array<Bin, MAX_BINS>, 3> bins_of_;
     uint32_t* idx_ = nullptr;
     std::vector<BvhNode>* nodes_ = nullptr;
@@ -236,7 +297,7 @@ private:
 } // namespace
 
 Bvh build_bvh(std::span<const Aabb> prim_bounds, const BvhBuildOptions& options) {
-    Bvh bvh = Builder(prim_bounds, options).build();
+    Bvh bvh = Builder(prim_bounds, options).build(options.threads);
     if (options.min_node_extent > 0.0f) pad_node_bounds(bvh, options.min_node_extent);
     return bvh;
 }

@@ -3,6 +3,7 @@
 
 #include <cfloat>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "engine/bvh/aabb_ops.h"
@@ -198,6 +199,58 @@ TEST(BvhBuilder, TooDeepInputStaysWithinStack) {
     Bvh bvh = build_bvh(prims, o);
     check_invariants(bvh, prims, o);
     EXPECT_LE(bvh.max_depth(), 20u);
+}
+
+// The multi-threaded build gives the one-thread build's Bvh node for node (bounds to the bit, links,
+// ranges, depths) and the same primitive order, whatever the thread count, on sets large enough to be
+// split across threads: random triangles, clusters of identical centroids (median splits decided by
+// nth_element on the range's order), a flat set, skipped primitives, and the depth fallback.
+TEST(BvhBuilder, ThreadsGiveTheSameTree) {
+    std::mt19937 rng(9);
+    std::vector<std::vector<Aabb>> sets;
+    sets.push_back(triangle_bounds(test::random_soup(rng, 200000, 10.0f, 0.05f)));
+    std::vector<Aabb> clusters = triangle_bounds(test::random_soup(rng, 60000, 3.0f, 0.1f));
+    for (size_t i = 0; i < clusters.size(); i += 3) { // every third box centred on one of 5 points
+        const float c = float(i % 5);
+        clusters[i] = Aabb{};
+        clusters[i].grow(glm::vec3(c - 0.01f * float(i % 7 + 1)));
+        clusters[i].grow(glm::vec3(c + 0.01f * float(i % 7 + 1)));
+    }
+    for (size_t i = 1; i < clusters.size(); i += 97) clusters[i] = Aabb{}; // skipped
+    clusters[2].lo.x = std::nanf("");                                      // skipped
+    sets.push_back(clusters);
+    std::vector<Aabb> flat = triangle_bounds(test::random_soup(rng, 80000, 5.0f, 0.02f));
+    for (Aabb& b : flat) b.lo.z = b.hi.z = 1.0f;
+    sets.push_back(flat);
+    std::vector<Aabb> nested(70000); // identical centroids: median splits all the way down
+    for (size_t i = 0; i < nested.size(); ++i) {
+        nested[i].grow(glm::vec3(-1.0f - float(i)));
+        nested[i].grow(glm::vec3(1.0f + float(i)));
+    }
+    sets.push_back(nested);
+    for (size_t s = 0; s < sets.size(); ++s) {
+        for (uint32_t leaf : {1u, 4u}) {
+            SCOPED_TRACE("set " + std::to_string(s) + " leaf " + std::to_string(leaf));
+            BvhBuildOptions o;
+            o.max_leaf_size = leaf;
+            o.threads = 1;
+            const Bvh one = build_bvh(sets[s], o);
+            check_invariants(one, sets[s], o);
+            for (uint32_t threads : {2u, 3u, 8u, 0u}) {
+                o.threads = threads;
+                const Bvh many = build_bvh(sets[s], o);
+                ASSERT_EQ(many.prim_indices, one.prim_indices) << threads << " threads";
+                ASSERT_EQ(many.nodes.size(), one.nodes.size()) << threads << " threads";
+                for (size_t i = 0; i < one.nodes.size(); ++i) {
+                    const BvhNode &a = one.nodes[i], &b = many.nodes[i];
+                    ASSERT_TRUE(std::memcmp(&a.bounds, &b.bounds, sizeof(Aabb)) == 0 && a.left == b.left &&
+                                a.right == b.right && a.first == b.first && a.count == b.count &&
+                                a.parent == b.parent && a.depth == b.depth)
+                        << threads << " threads, node " << i;
+                }
+            }
+        }
+    }
 }
 
 // A CPU closest-hit traversal over the GpuBvhNode array (what the shaders do) must match the Bvh.
