@@ -27,8 +27,8 @@ namespace {
 constexpr uint32_t MAX_BINS = 256;
 constexpr uint32_t DEPTH_LIMIT = NB_BVH_MAX_DEPTH - 1; // deepest allowed node depth (root = 0)
 constexpr uint64_t MAX_PRIMS = uint64_t(1) << NB_LEAF_FIRST_BITS;
-constexpr uint32_t PARALLEL_MIN_PRIMS = 1u
-                                        << 14; // smaller subtrees are built on the thread that reaches them
+// Subtrees with fewer primitives are built on the thread that reaches them.
+constexpr uint32_t PARALLEL_MIN_PRIMS = 1u << 14;
 
 struct Bin {
     Aabb bounds;
@@ -124,12 +124,12 @@ public:
         std::vector<BvhNode> r = build_parallel(right, levels - 1);
         std::vector<BvhNode> l = fl.get();
         // [node, left, right] + the right subtree's descendants + the left subtree's.
-        const uint32_t r_base = 2,
-                       l_base = uint32_t(r.size()) + 1; // where local index 1.. of each goes, minus 1
+        // Local index k >= 1 of the right subtree goes to r_base + k, of the left one to l_base + k.
+        const uint32_t r_base = 2, l_base = uint32_t(r.size()) + 1;
         std::vector<BvhNode> out;
         out.reserve(1 + r.size() + l.size());
         out.push_back(node);
-        auto place = [&out](BvhNode n, uint32_t self, uint32_t base) { // local index k >= 1 -> base + k
+        auto place = [&out](BvhNode n, uint32_t self, uint32_t base) { // local 0 (the subtree root) -> self
             auto map = [&](uint32_t k) { return k == BVH_INVALID ? k : k == 0 ? self : base + k; };
             n.left = map(n.left);
             n.right = map(n.right);
