@@ -11,11 +11,10 @@
 namespace nbvh::render {
 
 uint64_t mesh_gpu_bytes(const Mesh& mesh, const MeshBvh& blas) {
+    const uint64_t vertices = uint64_t(mesh.positions.size()) * sizeof(GpuVertex);
     if (blas.bounds_only)
-        return uint64_t(mesh.positions.size()) * sizeof(GpuVertex) +
-               uint64_t(mesh.triangle_count()) * sizeof(GpuTriangle);
-    return uint64_t(mesh.positions.size()) * sizeof(GpuVertex) +
-           uint64_t(blas.triangle_count()) * sizeof(GpuTriangle) +
+        return vertices + uint64_t(mesh.triangle_count()) * sizeof(GpuTriangle); // no nodes built
+    return vertices + uint64_t(blas.triangle_count()) * sizeof(GpuTriangle) +
            uint64_t(to_wide_layout(blas.bvh).size()) * sizeof(GpuWideNode);
 }
 

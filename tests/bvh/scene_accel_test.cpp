@@ -167,11 +167,22 @@ TEST(SceneAccel, BoundsOnlyMeshesKeepTheTlas) {
     EXPECT_THROW(intersect_any(mesh0, Ray{glm::vec3(0.0f, 0.0f, -10.0f), glm::vec3(0, 0, 1)}, 0.0f, NB_INF),
                  Error);
     const SceneAccel mesh1 = build_scene_accel_bounds_only(s, {false, true});
-    const Ray far_side{glm::vec3(3.0f, 0.0f, -10.0f), glm::vec3(0, 0, 1)}; // through instance 1 only
-    SceneHit a, b;
-    ASSERT_EQ(intersect_closest(mesh1, far_side, 0.0f, NB_INF, a),
-              intersect_closest(full, far_side, 0.0f, NB_INF, b));
-    EXPECT_EQ(a.t, b.t);
+    // Rays through instance 1 (mesh 0, around (3, 0, 0)) and no mesh-1 instance: the same hits.
+    int hits = 0;
+    for (int i = 0; i < 15; ++i)
+        for (int j = 0; j < 15; ++j) {
+            const Ray r{glm::vec3(2.2f + 0.11f * float(i), -0.8f + 0.11f * float(j), -10.0f),
+                        glm::vec3(0, 0, 1)};
+            SceneHit a, b;
+            const bool ha = intersect_closest(mesh1, r, 0.0f, NB_INF, a);
+            ASSERT_EQ(ha, intersect_closest(full, r, 0.0f, NB_INF, b)) << i << " " << j;
+            if (!ha) continue;
+            ++hits;
+            EXPECT_EQ(a.t, b.t);
+            EXPECT_EQ(a.instance, 1u);
+            EXPECT_EQ(a.triangle, b.triangle);
+        }
+    EXPECT_GT(hits, 20) << "the rays must reach instance 1's triangles";
     EXPECT_TRUE(build_scene_accel_bounds_only(s, {}).meshes[0].bvh.nodes.size() > 1) << "no flags: all built";
 }
 
