@@ -5,18 +5,18 @@
 # paper's Statuette). One binary, one GPU call. Per scene and level:
 #   - a model trained by `nbvh train --subdivide L` with no other flag (its wall time recorded);
 #   - 1920x1080, SPP (16) spp, max depth 8, render defaults: classical, hybrid, classical, hybrid (REPS
-#     rounds, the fastest of each; GPU timestamps), each after WARMUP (16, the most nbvh render takes) untimed renders of the same image
-#     in its process (`--warmup 16`, ~0.3-0.6 s of GPU work: the GPU idles through a large scene's BVH
-#     build and starts the next frame at low clocks; separate warm-up processes do not help there, and
-#     two warm-up renders left both classical renders of the dragon at level 1 3-4x slow in one call);
+#     rounds, the fastest of each; GPU timestamps), each after WARMUP (16, the most nbvh render takes)
+#     untimed renders of the same image in its process (~0.3-0.6 s of GPU work: the GPU idles through a
+#     large scene's BVH build and starts the next frame at low clocks; separate warm-up processes do not
+#     help there, and two warm-up renders left both classical renders of the dragon at level 1 3-4x slow);
 #   - then one more render per side without warm-up: its wall time (load, subdivision, BVH builds,
 #     pipelines, the frame, the PNG: what a user waits for one image) and its "BVHs built in" time;
 #   - at FLIP_W x FLIP_H (960x540), FLIP_SPP (2048) spp: a classical reference of seed 7, the classical
 #     render of seed 0 (the noise floor) and the hybrid of seed 0, LDR-FLIP of both against the reference.
 # Usage (GPU machine, after `source .device/env.sh`): SCENES="dragon default" LEVELS="0 1 2" \
 #   scripts/bench/dense_assets.sh OUT     (NBVH: the binary, default .device/study/bin/nbvh)
-# Env also: WIDTH, HEIGHT (1920x1080), REPS (timed renders per side, 2), WARMUP (16, the most nbvh render takes), TRAIN_ARGS (extra `nbvh train` flags; CI's dry run trains tiny CPU
-# models with them, tests/bench/bench_scripts_dry_run.sh).
+# Env also: WIDTH, HEIGHT (1920x1080), REPS (timed renders per side, 2), WARMUP (16), TRAIN_ARGS (extra
+# `nbvh train` flags; CI's dry run trains tiny CPU models with them, tests/bench/bench_scripts_dry_run.sh).
 # Writes OUT/dense.json (every row), OUT/train_SCENE_L.log, OUT/device.txt; prints a table.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
