@@ -68,6 +68,13 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
            "asset (on, default) or bounces on inside it (off: the paper's and the official code's behaviour)")
         ->check(CLI::IsMember({"on", "off"}));
     cmd->add_option_function<std::string>(
+           "--neural-query", [&o](const std::string& v) { o.neural.split_query = v == "split"; },
+           "the neural query pass as a gather pass then an MLP pass (split, default where the fp32 "
+           "cooperative-matrix MLP runs: the gathers run at higher occupancy) or as one fused kernel "
+           "(fused); "
+           "same image")
+        ->check(CLI::IsMember({"split", "fused"}));
+    cmd->add_option_function<std::string>(
            "--sort-rays", [&o](const std::string& v) { o.sort_rays = v == "on"; },
            "trace secondary and shadow rays grouped by direction and origin (on, default) "
            "or in queue order (off); same image")

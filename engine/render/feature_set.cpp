@@ -35,7 +35,13 @@ std::string neural_rounds_text(const NeuralPlan& n, const char* traverse, const 
     if (n.batched_rounds > 0) {
         s += strfmt("    repeat %u x (batched rounds):\n", n.batched_rounds);
         s += "      passes/neural_args.comp    queued pairs -> indirect dispatch arguments\n";
-        s += strfmt("      %-26s hash grid + MLP of the queued pairs\n", n.query_shader.c_str());
+        if (n.split_query) {
+            s += "      passes/neural_gather.comp  hash grid of the queued pairs -> features (per chunk; "
+                 "--neural-query)\n";
+            s += "      passes/neural_query_mlp32.comp MLP of those features -> the pairs' hits\n";
+        } else {
+            s += strfmt("      %-26s hash grid + MLP of the queued pairs\n", n.query_shader.c_str());
+        }
         s += strfmt("      %-26s op 1: resume the queried rays, queue their next leaves\n", traverse);
     }
     s += "    passes/neural_args.comp    rays still going -> indirect dispatch arguments\n";
@@ -124,7 +130,8 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
     // The renderer's own stage (ray capacity 1: only its choices are read, no ray buffers are installed).
     const NeuralStage stage(*ctx, *o.model, scene, o, 1);
     NeuralPlan p;
-    p.kernel = stage.kernel().describe();
+    p.kernel = stage.query_description();
+    p.split_query = stage.split_chunks() > 0;
     p.query_shader = stage.query_shader();
     p.lod_primary = stage.params().lod_primary;
     p.lod_secondary = stage.params().lod_secondary;

@@ -62,7 +62,8 @@ SceneFeatures sampled_features(SceneFeatures derived, const GpuSceneData& data);
 // What the neural stage of a hybrid render runs (engine/render/NEURAL.md), read from a NeuralStage.
 struct NeuralPlan {
     std::string kernel;            // MLP path, NeuralKernelChoice::describe()
-    std::string query_shader;      // shader of the batched query pass
+    std::string query_shader;      // shader of the batched query pass (the fused one)
+    bool split_query = false;      // the query pass as neural_gather + neural_query_mlp32 (--neural-query)
     uint32_t lod_primary = 0, lod_secondary = 0, lod_count = 1; // N-BVH cuts (0 = finest) of the model
     uint32_t leaf_budget = 0;      // leaves queried per ray at most (--neural-max-leaves)
     uint32_t leaves_per_round = 0; // leaves a ray queues per round

@@ -1,6 +1,7 @@
 #include "engine/render/neural_model_gpu.h"
 
 #include <algorithm>
+#include <optional>
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
@@ -187,15 +188,23 @@ const char* eval_shader(const NeuralKernelChoice& c) {
 }
 } // namespace
 
-NeuralEvaluator::NeuralEvaluator(const vk::Context& ctx, const NeuralModelGpu& model, NeuralKernelChoice choice,
-                                 uint32_t part)
-    : ctx_(ctx), model_(model), choice_(choice) {
+NeuralEvaluator::NeuralEvaluator(const vk::Context& ctx, const NeuralModelGpu& model,
+                                 NeuralKernelChoice choice, uint32_t part)
+    : ctx_(ctx), model_(model), choice_(choice), part_(part) {
+    const bool split = part >= 3;
+    NBVH_CHECK(!split || (choice_.path == NeuralPath::coopmat && choice_.fp32_accumulate));
     vk::PipelineDesc desc;
-    desc.shader = eval_shader(choice_);
-    for (uint32_t b = 0; b <= NB_NEVAL_BIND_HITS; ++b) desc.bindings.push_back({b, vk::BindingType::storage_buffer, 1});
+    desc.shader = split ? "passes/neural_eval_mlp32.comp" : eval_shader(choice_);
+    for (uint32_t b = 0; b <= (split ? NB_NEVAL_BIND_FEATURES : NB_NEVAL_BIND_HITS); ++b)
+        desc.bindings.push_back({b, vk::BindingType::storage_buffer, 1});
     desc.push_constant_bytes = sizeof(GpuNeuralEvalPush);
-    if (choice_.path == NeuralPath::coopmat) desc.spec = {{0, part}};
+    if (choice_.path == NeuralPath::coopmat) desc.spec = {{0, split ? 0u : part}};
     pipeline_ = vk::ComputePipeline(ctx_, desc);
+    if (split) {
+        desc.shader = "passes/neural_eval_gather.comp";
+        desc.spec = {};
+        gather_ = vk::ComputePipeline(ctx_, desc);
+    }
 }
 
 void NeuralEvaluator::ensure_capacity(size_t count) {
@@ -203,6 +212,9 @@ void NeuralEvaluator::ensure_capacity(size_t count) {
     capacity_ = std::max<size_t>(count, 64);
     queries_ = vk::Buffer(ctx_, capacity_ * sizeof(GpuNeuralQuery), vk::MemoryKind::device, 0, "neural queries");
     hits_ = vk::Buffer(ctx_, capacity_ * sizeof(GpuNeuralHit), vk::MemoryKind::device, 0, "neural hits");
+    if (part_ >= 3)
+        features_ = vk::Buffer(ctx_, (capacity_ + NB_NEURAL_GROUP) * NB_SPLIT_FEATURE_QUADS * 8u,
+                               vk::MemoryKind::device, 0, "neural features");
 }
 
 void NeuralEvaluator::upload_queries(const std::vector<GpuNeuralQuery>& queries) {
@@ -219,12 +231,20 @@ std::vector<GpuNeuralHit> NeuralEvaluator::evaluate(const std::vector<GpuNeuralQ
 
 double NeuralEvaluator::time_dispatch(uint32_t count, int repetitions, float threshold) {
     NBVH_CHECK(count <= capacity_);
-    vk::DescriptorSet set(ctx_, pipeline_);
-    set.bind(NB_NEVAL_BIND_LEVELS, model_.levels())
-        .bind(NB_NEVAL_BIND_GRID, model_.grid())
-        .bind(NB_NEVAL_BIND_MLP, choice_.path == NeuralPath::coopmat ? model_.mlp_transposed() : model_.mlp())
-        .bind(NB_NEVAL_BIND_QUERIES, queries_)
-        .bind(NB_NEVAL_BIND_HITS, hits_);
+    auto make_set = [&](const vk::ComputePipeline& p) {
+        vk::DescriptorSet set(ctx_, p);
+        set.bind(NB_NEVAL_BIND_LEVELS, model_.levels())
+            .bind(NB_NEVAL_BIND_GRID, model_.grid())
+            .bind(NB_NEVAL_BIND_MLP,
+                  choice_.path == NeuralPath::coopmat ? model_.mlp_transposed() : model_.mlp())
+            .bind(NB_NEVAL_BIND_QUERIES, queries_)
+            .bind(NB_NEVAL_BIND_HITS, hits_);
+        if (part_ >= 3) set.bind(NB_NEVAL_BIND_FEATURES, features_);
+        return set;
+    };
+    vk::DescriptorSet set = make_set(pipeline_);
+    std::optional<vk::DescriptorSet> gather_set;
+    if (part_ >= 3) gather_set.emplace(make_set(gather_));
     GpuNeuralEvalPush push{};
     push.box = model_.box();
     push.count = count;
@@ -235,7 +255,11 @@ double NeuralEvaluator::time_dispatch(uint32_t count, int repetitions, float thr
     if (timer.available()) timer.reset(cmd.handle());
     for (int r = 0; r < std::max(1, repetitions); ++r) {
         cmd.begin_pass("neural eval", timer.available() ? &timer : nullptr);
-        cmd.bind(pipeline_, set).push(push).dispatch_items(count, NB_NEURAL_GROUP);
+        if (part_ == 3 || part_ == 4) {
+            cmd.bind(gather_, *gather_set).push(push).dispatch_items(count, NB_NEURAL_GROUP);
+            if (part_ == 3) cmd.barrier(vk::Barrier::compute_to_compute);
+        }
+        if (part_ != 4) cmd.bind(pipeline_, set).push(push).dispatch_items(count, NB_NEURAL_GROUP);
         cmd.end_pass();
         cmd.barrier(vk::Barrier::compute_to_compute);
     }

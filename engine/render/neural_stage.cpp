@@ -8,6 +8,7 @@
 #include "engine/core/error.h"
 #include "engine/core/log.h"
 #include "engine/neural/asset_table.h"
+#include "engine/render/wave_plan.h"
 #include "shaders/shared/scene_gpu.h"
 #include "shaders/shared/wavefront_gpu.h"
 
@@ -109,6 +110,37 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
       rounds_(o.max_rounds), capacity_(ray_capacity) {
     set_params(o);
     assets_ = asset_table(model, model_, scene, o);
+    if (o.split_query && kernel_.path == NeuralPath::coopmat && kernel_.fp32_accumulate) {
+        // The features buffer: one binding, and at most an eighth of the GPU's memory (beside the wave's
+        // queues, a quarter by default): a wave larger than one chunk takes its rounds in chunks.
+        const WaveLimits limits = wave_limits(ctx.features());
+        const uint64_t bytes = limits.device_local_bytes
+                                   ? std::min(limits.buffer_bytes, limits.device_local_bytes / 8)
+                                   : limits.buffer_bytes;
+        const SplitPlan plan = plan_split_query(uint64_t(params_.leaves_per_round) * std::max(capacity_, 1u),
+                                                bytes, o.split_chunk_limit);
+        params_.split_chunk = plan.chunk;
+        split_chunks_ = plan.chunks;
+    }
+}
+
+SplitPlan plan_split_query(uint64_t pairs_per_half, uint64_t buffer_bytes, uint64_t limit) {
+    constexpr uint64_t quad_bytes = 8ull * NB_SPLIT_FEATURE_QUADS;
+    const uint64_t group = NB_NEURAL_GROUP;
+    uint64_t fit = buffer_bytes / quad_bytes / group * group;
+    if (limit > 0) fit = std::min(fit, limit / group * group);
+    const uint64_t wanted = (std::max<uint64_t>(pairs_per_half, 1) + group - 1) / group * group;
+    const uint64_t chunk = std::min(fit, wanted);
+    if (chunk == 0) return {};
+    const uint64_t chunks = (wanted + chunk - 1) / chunk;
+    if (chunks > NB_SPLIT_MAX_CHUNKS || chunk * NB_SPLIT_MAX_CHUNKS > 0xFFFFFFFFull) return {};
+    return {uint32_t(chunk), uint32_t(chunks)};
+}
+
+std::string NeuralStage::query_description() const {
+    std::string d = kernel_.describe();
+    if (split_chunks_ == 0) return d;
+    return d.substr(0, d.find(" (")) + " (split: gather pass + MLP pass, 64 queries per workgroup)";
 }
 
 std::vector<GpuNeuralAsset> NeuralStage::asset_table(const NeuralModel& model, const NeuralModelGpu& gpu,
@@ -212,10 +244,13 @@ void NeuralStage::install(std::vector<vk::Buffer>& buffers) {
     // Path rays at [0, capacity), shadow rays at [capacity, 2 capacity).
     buffers[NB_BIND_NEURAL_STATE] = vk::Buffer(ctx_, 2ull * std::max(capacity_, 1u) * sizeof(GpuNeuralRayState),
                                                vk::MemoryKind::device, 0, "neural ray state");
-    buffers[NB_BIND_NEURAL_COUNTERS] =
-        vk::Buffer(ctx_, sizeof(GpuNeuralCounters), vk::MemoryKind::device, 0, "neural counters");
+    buffers[NB_BIND_NEURAL_COUNTERS] = vk::Buffer(ctx_, sizeof(GpuNeuralCounters), vk::MemoryKind::device,
+                                                  VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, "neural counters");
     buffers[NB_BIND_NEURAL_STATE].fill(0u);
     buffers[NB_BIND_NEURAL_COUNTERS].fill(0u);
+    if (split_chunks_ > 0)
+        split_features_ = vk::Buffer(ctx_, uint64_t(params_.split_chunk) * 8u * NB_SPLIT_FEATURE_QUADS,
+                                     vk::MemoryKind::device, 0, "split query features");
 }
 
 void NeuralStage::install_placeholders(const vk::Context& ctx, std::vector<vk::Buffer>& buffers) {

@@ -76,6 +76,14 @@ struct NeuralRenderOptions {
     // triangles, BLAS), so the GPU memory of a hybrid render no longer grows with the triangles the
     // model replaces; such a renderer cannot switch to the classical reference (apply() returns false).
     bool keep_neural_triangles = true;
+    // The query pass in two passes where the fp32 cooperative-matrix kernel runs: a gather pass (few
+    // registers, many resident subgroups to hide the hash grid's gathers) writes each pair's features,
+    // then the MLP pass reads them (shared/neural_gpu.h NB_SPLIT_*; the same features, so the same image);
+    // false: the fused pass (gathers and MLP in one kernel). --neural-query split|fused.
+    bool split_query = true;
+    // At most this many pairs per chunk of the split query pass (0: as many as one buffer holds); tests
+    // use it to take a round in several chunks.
+    uint32_t split_chunk_limit = 0;
 };
 
 // Leaves per round of `options` (throws nbvh::Error when out of range).
@@ -122,6 +130,12 @@ public:
 
     const NeuralKernelChoice& kernel() const { return kernel_; }
     const char* query_shader() const;
+    // The split query pass (NeuralRenderOptions::split_query, where the kernel allows): chunks of the
+    // round's pairs recorded per round (0: the fused pass), and the features buffer they share (bound at
+    // NB_BIND_OUTPUT in the split passes' descriptor sets, lib/bindings.glsl).
+    uint32_t split_chunks() const { return split_chunks_; }
+    const vk::Buffer& split_features() const { return split_features_; }
+    std::string query_description() const;
     uint32_t rounds() const { return rounds_; }
     uint32_t batched_rounds() const { return batched_; }
     uint32_t leaves_per_round() const { return params_.leaves_per_round; }
@@ -144,6 +158,18 @@ private:
     uint32_t rounds_ = 0;
     uint32_t batched_ = 0;
     uint32_t capacity_ = 0;
+    uint32_t split_chunks_ = 0;
+    vk::Buffer split_features_;
 };
+
+// Pairs per chunk of the split query pass and chunks per round for `pairs_per_half` pairs (a pending
+// half's capacity) with buffers of at most `buffer_bytes`: a multiple of NB_NEURAL_GROUP pairs whose
+// features fit one buffer (and, when `limit` > 0, at most `limit` rounded down to that multiple);
+// {0, 0} (the fused pass) when more than NB_SPLIT_MAX_CHUNKS chunks would be needed.
+struct SplitPlan {
+    uint32_t chunk = 0;
+    uint32_t chunks = 0;
+};
+SplitPlan plan_split_query(uint64_t pairs_per_half, uint64_t buffer_bytes, uint64_t limit = 0);
 
 } // namespace nbvh::render

@@ -19,18 +19,30 @@ namespace nbvh::render {
 namespace {
 
 enum Pass : size_t {
-    CAMERA, QUEUE_ARGS, TRAVERSE, SHADE, SHADOW, ACCUMULATE, RESOLVE, RAY_SORT,
-    NEURAL_TRAVERSE, NEURAL_ARGS, NEURAL_QUERY, NEURAL_SHADOW, NEURAL_TAIL, // hybrid renders only (neural_stage.h)
+    CAMERA,
+    QUEUE_ARGS,
+    TRAVERSE,
+    SHADE,
+    SHADOW,
+    ACCUMULATE,
+    RESOLVE,
+    RAY_SORT,
+    NEURAL_TRAVERSE,
+    NEURAL_ARGS,
+    NEURAL_QUERY,
+    NEURAL_SHADOW,
+    NEURAL_TAIL, // hybrid renders only (neural_stage.h)
+    NEURAL_GATHER,
+    NEURAL_MLP, // the split query pass only (NeuralStage::split_chunks)
     PASS_COUNT
 };
 // NEURAL_QUERY's shader depends on the MLP path (NeuralStage::query_shader); this entry names its timer.
-const char* const PASS_SHADERS[PASS_COUNT] = {"passes/camera_rays.comp", "passes/queue_args.comp",
-                                              "passes/traverse.comp",    "passes/shade.comp",
-                                              "passes/shadow.comp",      "passes/accumulate.comp",
-                                              "passes/resolve.comp",     "passes/ray_sort.comp",
-                                              "passes/neural_traverse.comp",
-                                              "passes/neural_args.comp", "passes/neural_query.comp",
-                                              "passes/neural_shadow.comp", "passes/neural_tail.comp"};
+const char* const PASS_SHADERS[PASS_COUNT] = {
+    "passes/camera_rays.comp", "passes/queue_args.comp",    "passes/traverse.comp",
+    "passes/shade.comp",       "passes/shadow.comp",        "passes/accumulate.comp",
+    "passes/resolve.comp",     "passes/ray_sort.comp",      "passes/neural_traverse.comp",
+    "passes/neural_args.comp", "passes/neural_query.comp",  "passes/neural_shadow.comp",
+    "passes/neural_tail.comp", "passes/neural_gather.comp", "passes/neural_query_mlp32.comp"};
 
 template <class T> vk::Buffer upload(const vk::Context& ctx, const std::vector<T>& items, const char* name) {
     return vk::make_buffer(ctx, items, name);
@@ -201,7 +213,10 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
                                : vk::Binding{b, vk::BindingType::storage_buffer, 1});
     const std::vector<vk::SpecConstant> spec = specialization(features_);
     for (size_t i = 0; i < PASS_COUNT; ++i) {
-        if (((i == SHADOW || i == NEURAL_SHADOW) && !features_.has_lights()) || (i >= NEURAL_TRAVERSE && !neural_)) {
+        const bool split_pass = i == NEURAL_GATHER || i == NEURAL_MLP;
+        if (((i == SHADOW || i == NEURAL_SHADOW) && !features_.has_lights()) ||
+            (i >= NEURAL_TRAVERSE && !neural_) ||
+            (split_pass && (!neural_ || neural_->split_chunks() == 0))) {
             pipelines_.emplace_back();
             sets_.emplace_back();
             continue; // no shadow pass without anything to sample
@@ -215,7 +230,8 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
         pipelines_.emplace_back(ctx_, desc);
         vk::DescriptorSet set(ctx_, pipelines_.back());
         for (uint32_t b = 0; b < NB_NEURAL_BINDING_END; ++b)
-            if (!(texture_array && b == NB_BIND_TEXELS)) set.bind(b, buffers_[b]);
+            if (!(texture_array && b == NB_BIND_TEXELS))
+                set.bind(b, split_pass && b == NB_BIND_OUTPUT ? neural_->split_features() : buffers_[b]);
         if (texture_array) texture_array_.bind(set, NB_BIND_TEXELS);
         sets_.push_back(std::move(set));
     }
@@ -259,7 +275,11 @@ void WavefrontRenderer::make_timer() {
                                                                std::max<uint64_t>(pixels, 1),
                                                            wave_samples_, std::max(wave_samples_, MAX_SAMPLES_PER_SUBMISSION)));
     const uint32_t waves = (samples_per_submission_ + wave_samples_ - 1) / wave_samples_;
-    const uint32_t per_wave = 2 + (8 + (neural_ ? 6 * neural_->batched_rounds() + 8 : 0)) * options_.max_depth;
+    // A round: args, query (split: gather and MLP per chunk), traversal; for path and shadow rays.
+    const uint32_t query_passes = neural_ && neural_->split_chunks() ? 2 * neural_->split_chunks() : 1;
+    const uint32_t per_round = 2 * (2 + query_passes);
+    const uint32_t per_wave =
+        2 + (8 + (neural_ ? per_round * neural_->batched_rounds() + 8 : 0)) * options_.max_depth;
     timer_ = vk::GpuTimer(ctx_, 62 + per_wave * waves);
 }
 
@@ -277,7 +297,8 @@ bool WavefrontRenderer::apply(const RenderOptions& o) {
         (n.model && effective_leaves_per_round(n) != neural_->leaves_per_round()) ||
         (n.classical && overrides) != classical_overrides_ ||
         (n.model && !features_.neural && !n.classical) || (n.classical && triangles_omitted_) ||
-        n.keep_neural_triangles != cn.keep_neural_triangles || !(o.forced_features == c.forced_features) ||
+        n.keep_neural_triangles != cn.keep_neural_triangles || n.split_query != cn.split_query ||
+        n.split_chunk_limit != cn.split_chunk_limit || !(o.forced_features == c.forced_features) ||
         capacity_ > counter_safe_paths(o))
         return false;
     if (n.model) validate(n, *scene_);
@@ -326,7 +347,9 @@ GpuPassConstants WavefrontRenderer::constants(uint32_t queue, uint32_t depth, co
 
 void WavefrontRenderer::record_pass(vk::CommandBuffer& cmd, size_t pass, const GpuPassConstants& pc,
                                     Dispatch dispatch, uint64_t items) {
-    cmd.begin_pass(PASS_SHADERS[pass], timer_.available() ? &timer_ : nullptr, pc.depth);
+    // The split query's MLP pass is timed as the query pass (it decodes and stores the results).
+    cmd.begin_pass(PASS_SHADERS[pass == NEURAL_MLP ? NEURAL_QUERY : pass],
+                   timer_.available() ? &timer_ : nullptr, pc.depth);
     cmd.bind(pipelines_[pass], sets_[pass]).push(pc);
     switch (dispatch) {
     case Dispatch::items: cmd.dispatch_items(items, NB_WAVEFRONT_GROUP); break;
@@ -337,6 +360,10 @@ void WavefrontRenderer::record_pass(vk::CommandBuffer& cmd, size_t pass, const G
         break;
     case Dispatch::indirect_pending:
         cmd.dispatch_indirect(buffers_[NB_BIND_COUNTERS], NB_COUNTERS_PENDING_DISPATCH_OFFSET);
+        break;
+    case Dispatch::indirect_split:
+        cmd.dispatch_indirect(buffers_[NB_BIND_NEURAL_COUNTERS],
+                              NB_NEURAL_SPLIT_DISPATCH_OFFSET + uint32_t(items) * sizeof(GpuDispatchArgs));
         break;
     }
     cmd.end_pass();
@@ -358,13 +385,31 @@ void WavefrontRenderer::record_neural_rounds(vk::CommandBuffer& cmd, size_t trav
     for (uint32_t round = 0; round < batched; ++round) {
         const uint32_t half = round & 1u;
         record_pass(cmd, NEURAL_ARGS, constants(q, depth, w, 0), Dispatch::single);
-        record_pass(cmd, NEURAL_QUERY, constants(q, depth, w, half << 2), Dispatch::indirect_pending);
+        record_query(cmd, constants(q, depth, w, half << 2));
         record_pass(cmd, traverse_pass, constants(q, depth, w, 1u | ((half ^ 1u) << 2)),
                     Dispatch::indirect_pending);
     }
     // The few rays left finish in one pass (query, resume, query, ... per invocation).
     record_pass(cmd, NEURAL_ARGS, constants(q, depth, w, 0), Dispatch::single);
     record_pass(cmd, NEURAL_TAIL, constants(q, depth, w, (batched & 1u) << 2), Dispatch::indirect_pending);
+}
+
+uint32_t WavefrontRenderer::neural_split_chunks() const { return neural_ ? neural_->split_chunks() : 0u; }
+
+void WavefrontRenderer::record_query(vk::CommandBuffer& cmd, const GpuPassConstants& pc) {
+    const uint32_t chunks = neural_->split_chunks();
+    if (chunks == 0) {
+        record_pass(cmd, NEURAL_QUERY, pc, Dispatch::indirect_pending);
+        return;
+    }
+    // Chunk c: pairs [c * split_chunk, ...) of the round (neural_args wrote each chunk's dispatch; the
+    // chunks past the round's pairs dispatch no workgroup). The features buffer holds one chunk.
+    for (uint32_t c = 0; c < chunks; ++c) {
+        GpuPassConstants chunk_pc = pc;
+        chunk_pc.mode |= c << NB_SPLIT_CHUNK_SHIFT;
+        record_pass(cmd, NEURAL_GATHER, chunk_pc, Dispatch::indirect_split, c);
+        record_pass(cmd, NEURAL_MLP, chunk_pc, Dispatch::indirect_split, c);
+    }
 }
 
 bool WavefrontRenderer::record_ray_sort(vk::CommandBuffer& cmd, uint32_t q, uint32_t depth, const Wave& w, bool shadow) {
@@ -542,14 +587,15 @@ RenderResult WavefrontRenderer::render_samples(uint32_t first, uint32_t count_sa
     s.texture_bytes = texture_plan_.bytes;
     s.texture_halvings = data_.texture_downscales;
     if (hybrid_) {
-        s.neural_path = neural_->kernel().describe();
+        s.neural_path = neural_->query_description();
         s.neural_queries = totals[4];
         s.neural_rounds = totals[5];
         s.neural_leaf_cap_rays = totals[6];
         s.neural_queries_by_depth.assign(totals + 7 + 2 * NB_STAT_DEPTHS,
                                          totals + 7 + 2 * NB_STAT_DEPTHS + depths);
         for (const auto& [name, ms] : pass_ms)
-            if (name == PASS_SHADERS[NEURAL_QUERY]) s.neural_query_ms += ms;
+            if (name == PASS_SHADERS[NEURAL_QUERY] || name == PASS_SHADERS[NEURAL_GATHER])
+                s.neural_query_ms += ms;
     }
     for (size_t i = 0; i < result.image.pixel_count(); ++i) {
         const float* px = result.image.data.data() + i * 4;

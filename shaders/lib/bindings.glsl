@@ -60,7 +60,17 @@ layout(set = 0, binding = NB_BIND_FILM, scalar) buffer FilmBuffer { vec4 film[];
 // consecutive 16-byte words here, read and written by lib/neural_bindings.glsl nb_pending_*.
 layout(set = 0, binding = NB_BIND_PENDING_LEAVES, std430) buffer PendingLeafBuffer { uvec4 pending_leaves[]; };
 layout(set = 0, binding = NB_BIND_PENDING_LEAVES_1, std430) buffer PendingLeafBuffer1 { uvec4 pending_leaves_1[]; };
+#ifdef NB_SPLIT_FEATURES
+#ifndef NB_SPLIT_FEATURES_ACCESS
+#define NB_SPLIT_FEATURES_ACCESS readonly // the MLP pass; the gather pass writes
+#endif
+// The split query's passes (shared/neural_gpu.h NB_SPLIT_*) never touch the output image: their
+// descriptor sets bind the features buffer here instead (the layout has no binding to spare: lavapipe
+// allows 32 storage buffers per stage, and the split passes run only where cooperative matrices do).
+layout(set = 0, binding = NB_BIND_OUTPUT, std430) NB_SPLIT_FEATURES_ACCESS buffer SplitFeaturesBuffer { uvec2 split_features[]; };
+#else
 layout(set = 0, binding = NB_BIND_OUTPUT, scalar) buffer OutputBuffer { vec4 output_pixels[]; };
+#endif
 // Ray order of the traversal and shadow passes (shared/wavefront_gpu.h NB_RS_*).
 layout(set = 0, binding = NB_BIND_RAY_SORT, std430) buffer RaySortBuffer {
     uint rs_bins[NB_RS_HEADER_WORDS];

@@ -2,6 +2,9 @@
 // workgroup through the fused cooperative-matrix MLP.
 #include "lib/neural_eval_common.glsl"
 layout(set = 0, binding = NB_NEVAL_BIND_MLP, std430) readonly buffer MlpBuffer { uvec4 neural_mlp_tiles[]; };
+#ifdef NB_SPLIT_FEATURES
+layout(set = 0, binding = NB_NEVAL_BIND_FEATURES, std430) readonly buffer FeatureBuffer { uvec2 split_features[]; };
+#endif
 #include "lib/neural_grid.glsl"
 #include "lib/neural_mlp_coopmat.glsl"
 
@@ -31,7 +34,11 @@ void main() {
             nb_coop_x_write4(local, f, v); // packing rounds to fp16
         }
     } else {
+#ifdef NB_SPLIT_FEATURES
+        nb_coop_stage_split_features(local, valid, i);
+#else
         nb_coop_stage_features(local, valid, p0, p1, p2);
+#endif
     }
     // Each subgroup stages and runs the MLP on only its own 32 rows: with NB_COOP_FAST a subgroup
     // barrier (shared-memory semantics) lets one subgroup's MLP overlap the other's gather.

@@ -99,6 +99,33 @@ void nb_neural_levels_paired(vec3 p_even, vec3 p_odd, uint l0, uint xbit, out ve
         }
     }
 }
+
+// A level's 4 features (already fp16 values) as one 8-byte quad of the split query's features buffer.
+uvec2 nb_split_quad(vec4 f) { return uvec2(packHalf2x16(f.xy), packHalf2x16(f.zw)); }
+
+// Runs BODY for every (point k, level l) of a segment's 3 points with `vec4 f` = that level's 4
+// features (fp16-rounded), through the paired-lane gather, NB_GATHER_LEVELS levels of a point at a
+// time (the fused query kernels stage f in shared memory, the split query's gather pass stores it).
+// All 32 lanes must be active.
+#define NB_PAIRED_GATHER_SEGMENT(P0, P1, P2, BODY)                                                    \
+    {                                                                                                 \
+        uint xbit_ = gl_SubgroupInvocationID & 1u;                                                    \
+        for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {                                               \
+            vec3 p_ = k == 0u ? (P0) : (k == 1u ? (P1) : (P2));                                       \
+            vec3 partner_ = subgroupShuffleXor(p_, 1u);                                               \
+            vec3 p_even_ = xbit_ == 0u ? p_ : partner_;                                               \
+            vec3 p_odd_ = xbit_ == 0u ? partner_ : p_;                                                \
+            for (uint l0_ = 0u; l0_ < NB_GRID_MAX_LEVELS; l0_ += NB_GATHER_LEVELS) {                  \
+                vec4 fs_[NB_GATHER_LEVELS];                                                           \
+                nb_neural_levels_paired(p_even_, p_odd_, l0_, xbit_, fs_);                            \
+                [[unroll]] for (uint g_ = 0u; g_ < NB_GATHER_LEVELS; ++g_) {                          \
+                    uint l = l0_ + g_;                                                                \
+                    vec4 f = fs_[g_];                                                                 \
+                    BODY                                                                              \
+                }                                                                                     \
+            }                                                                                         \
+        }                                                                                             \
+    }
 #endif
 
 // The 32 features (level-major, 4 per level) of one encoded point.

@@ -226,19 +226,7 @@ void nb_mlp_forward_coopmat() {
 // per-point array stays live); zeros when !valid.
 void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
 #if NB_COOP_FAST
-    uint xbit = gl_SubgroupInvocationID & 1u;
-    for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
-        vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
-        vec3 partner = subgroupShuffleXor(p, 1u);
-        vec3 p_even = xbit == 0u ? p : partner;
-        vec3 p_odd = xbit == 0u ? partner : p;
-        for (uint l0 = 0u; l0 < NB_GRID_MAX_LEVELS; l0 += NB_GATHER_LEVELS) {
-            vec4 f[NB_GATHER_LEVELS];
-            nb_neural_levels_paired(p_even, p_odd, l0, xbit, f);
-            [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g)
-                nb_coop_x_write4(local, nb_feature_slot(k, l0 + g, 0u), valid ? f[g] : vec4(0.0f));
-        }
-    }
+    NB_PAIRED_GATHER_SEGMENT(p0, p1, p2, nb_coop_x_write4(local, nb_feature_slot(k, l, 0u), valid ? f : vec4(0.0f));)
 #else
     for (uint k = 0u; k < NB_SEGMENT_POINTS; ++k) {
         vec3 p = k == 0u ? p0 : (k == 1u ? p1 : p2);
@@ -247,5 +235,21 @@ void nb_coop_stage_features(uint local, bool valid, vec3 p0, vec3 p1, vec3 p2) {
     }
 #endif
 }
+
+// The split query's MLP pass (shared/neural_gpu.h NB_SPLIT_*): query row `local`'s 96 features from
+// the features buffer the gather pass wrote (quad s of pair `index` at nb_split_index; the
+// includer defines NB_SPLIT_FEATURES and declares `uvec2 split_features[]`); zeros when !valid.
+#ifdef NB_SPLIT_FEATURES
+void nb_coop_stage_split_features(uint local, bool valid, uint index) {
+    for (uint s = 0u; s < NB_SPLIT_FEATURE_QUADS; ++s) {
+        uvec2 e = valid ? split_features[nb_split_index(index, s)] : uvec2(0u);
+        uint w = local * NB_COOP_STRIDE_V + s / 2u; // quad s holds features 4s..4s+3 (nb_coop_x_write4)
+        if ((s & 1u) == 0u)
+            nb_sh_x[w].xy = e;
+        else
+            nb_sh_x[w].zw = e;
+    }
+}
+#endif
 
 #endif

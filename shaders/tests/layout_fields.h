@@ -106,18 +106,25 @@
     F(normal) F(best_t) F(albedo_rg) F(albedo_b) F(hit_leaf) F(instance) F(key_t) F(key_instance)    \
     F(key_leaf) F(status)                                                                         \
     F(tri_t) F(tri_instance) F(tri_triangle) F(rounds)
-#define NB_LAYOUT_FIELDS_GpuNeuralParams(F)                                                       \
-    F(box.center) F(box.depth_pad) F(box.extent) F(box.fixed_depth_eps) F(lod_primary)            \
-    F(lod_secondary) F(roughness) F(metallic) F(threshold) F(max_rounds) F(leaves_per_round) F(occupancy) \
-    F(materials) F(material_fits) F(material_spread) F(pad2)
+#define NB_LAYOUT_FIELDS_GpuNeuralParams(F)                                                                  \
+    F(box.center)                                                                                            \
+    F(box.depth_pad)                                                                                         \
+    F(box.extent) F(box.fixed_depth_eps) F(lod_primary) F(lod_secondary) F(roughness) F(metallic)            \
+        F(threshold) F(max_rounds) F(leaves_per_round) F(occupancy) F(materials) F(material_fits)            \
+            F(material_spread) F(split_chunk)
 #define NB_LAYOUT_FIELDS_GpuNeuralCounters(F)                                                                \
     F(pending_active)                                                                                        \
-    F(queries_total) F(leaf_cap_rays) F(rounds) F(queries_total_hi) F(pad0) F(pad1) F(pad2)                  \
-        F(queries_by_depth[0]) F(queries_by_depth[1]) F(queries_by_depth[2]) F(queries_by_depth[3])          \
-            F(queries_by_depth[4]) F(queries_by_depth[5]) F(queries_by_depth[6]) F(queries_by_depth[7])      \
-                F(queries_by_depth[8]) F(queries_by_depth[9]) F(queries_by_depth[10])                        \
-                    F(queries_by_depth[11]) F(queries_by_depth[12]) F(queries_by_depth[13])                  \
-                        F(queries_by_depth[14]) F(queries_by_depth[15])
+    F(queries_total)                                                                                         \
+    F(leaf_cap_rays)                                                                                         \
+    F(rounds) F(queries_total_hi) F(pad0) F(pad1) F(pad2) F(queries_by_depth[0]) F(queries_by_depth[1])      \
+        F(queries_by_depth[2]) F(queries_by_depth[3]) F(queries_by_depth[4]) F(queries_by_depth[5])          \
+            F(queries_by_depth[6]) F(queries_by_depth[7]) F(queries_by_depth[8]) F(queries_by_depth[9])      \
+                F(queries_by_depth[10]) F(queries_by_depth[11]) F(queries_by_depth[12])                      \
+                    F(queries_by_depth[13]) F(queries_by_depth[14]) F(queries_by_depth[15])                  \
+                        F(split_dispatch[0].x) F(split_dispatch[0].y) F(split_dispatch[0].z)                 \
+                            F(split_dispatch[1].x) F(split_dispatch[1].y) F(split_dispatch[1].z)             \
+                                F(split_dispatch[2].x) F(split_dispatch[2].y) F(split_dispatch[2].z)         \
+                                    F(split_dispatch[3].x) F(split_dispatch[3].y) F(split_dispatch[3].z)
 #define NB_LAYOUT_FIELDS_GpuNeuralAsset(F)                                                        \
     F(roots[0]) F(roots[1]) F(roots[2]) F(roots[3]) F(roots[4]) F(roots[5]) F(roots[6]) F(roots[7]) \
     F(material) F(metallic) F(roughness) F(backface_escape)

@@ -130,6 +130,34 @@ int main(int argc, char** argv) try {
         std::printf("%-70s %9.3f ms / %zu queries = %.3f G queries/s\n", r.path.c_str(), r.ms, qs.size(), r.qps * 1e-9);
         rows.push_back(std::move(r));
     }
+    // The split query: a gather kernel writes the features, an MLP kernel reads them (prototype).
+    double ms_split_gather = 0, ms_split_mlp = 0;
+    size_t split_differs = 0;
+    const bool can_split = why.empty() && choose_neural_kernel(dev, NeuralPath::coopmat).fp32_accumulate;
+    if (can_split) {
+        const NeuralKernelChoice c = choose_neural_kernel(dev, NeuralPath::coopmat);
+        NeuralEvaluator ev(ctx, gpu, c, 3);
+        Row r;
+        r.path = "split: gather kernel + MLP kernel (fp32 accumulators)";
+        r.hits = ev.evaluate(qs);
+        r.ms = ev.time_dispatch(uint32_t(qs.size()), reps);
+        r.qps = r.ms > 0 ? double(qs.size()) / (r.ms * 1e-3) : 0.0;
+        std::printf("%-70s %9.3f ms / %zu queries = %.3f G queries/s\n", r.path.c_str(), r.ms, qs.size(),
+                    r.qps * 1e-9);
+        for (size_t i = 0; i < qs.size(); ++i)
+            if (std::memcmp(&r.hits[i], &rows[1].hits[i], sizeof(GpuNeuralHit)) != 0) ++split_differs;
+        std::printf("split vs fused coopmat: %zu of %zu hits differ (bitwise)\n", split_differs, qs.size());
+        rows.push_back(std::move(r));
+        NeuralEvaluator ge(ctx, gpu, c, 4);
+        ge.evaluate(qs);
+        ms_split_gather = ge.time_dispatch(uint32_t(qs.size()), reps);
+        NeuralEvaluator me(ctx, gpu, c, 5);
+        me.evaluate(qs);
+        ms_split_mlp = me.time_dispatch(uint32_t(qs.size()), reps);
+        std::printf("split breakdown: gather kernel %.3f ms (%.3f G/s), MLP kernel %.3f ms (%.3f G/s)\n",
+                    ms_split_gather, qs.size() / (ms_split_gather * 1e6), ms_split_mlp,
+                    qs.size() / (ms_split_mlp * 1e6));
+    }
     // Where the cooperative-matrix query's time goes: features only, MLP only.
     double ms_features = 0, ms_mlp = 0;
     if (why.empty()) {
@@ -160,7 +188,9 @@ int main(int argc, char** argv) try {
                 if (std::abs(a.visibility - NB_VISIBILITY_THRESHOLD) > 2e-3f) ++vis_diff_outside_margin;
             }
         }
-        const char* label = k == 1 ? "coopmat" : "coopmat fp16-acc";
+        const char* label = rows[k].path.rfind("split", 0) == 0 ? "split"
+                            : k == 1                            ? "coopmat"
+                                                                : "coopmat fp16-acc";
         std::printf("scalar vs %s: max |dy| %.3g, mean |dy| %.3g, visibility differs on %zu of %zu (%zu with "
                     "|y0 - 0.5| > 2e-3), non-finite coopmat outputs %zu\n",
                     label, max_dy, sum_dy / double(qs.size()), vis_diff, qs.size(), vis_diff_outside_margin, nonfinite);
@@ -181,7 +211,9 @@ int main(int argc, char** argv) try {
         for (size_t i = 0; i < rows.size(); ++i)
             f << (i ? ", " : "") << "{\"path\": \"" << rows[i].path << "\", \"ms\": " << rows[i].ms
               << ", \"queries_per_s\": " << rows[i].qps << "}";
-        f << "],\n  \"coopmat_features_only_ms\": " << ms_features << ",\n  \"coopmat_mlp_only_ms\": " << ms_mlp
+        f << "],\n  \"coopmat_features_only_ms\": " << ms_features
+          << ",\n  \"coopmat_mlp_only_ms\": " << ms_mlp << ",\n  \"split_gather_ms\": " << ms_split_gather
+          << ",\n  \"split_mlp_ms\": " << ms_split_mlp << ",\n  \"split_vs_fused_differs\": " << split_differs
           << ",\n  \"scalar_vs_coopmat\": " << agree << "\n}\n";
     }
     return 0;

@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstring>
 #include <memory>
 
 using namespace nbvh;
@@ -64,6 +65,17 @@ TEST(NeuralCoopmat, KernelsMatchFp16Reference) {
         EXPECT_EQ(c.acceptance_errors, 0) << choice.describe();
         EXPECT_GT(c.visible, int(qs.size() / 10));
         EXPECT_LT(c.visible, int(qs.size() * 9 / 10));
+    }
+    // The split query (gather kernel, then the MLP kernel on the stored features): the same features
+    // and the same MLP code as the fused fp32 kernel, so the same hits to the bit.
+    if (choices[0].fp32_accumulate) {
+        NeuralEvaluator fused(*ctx, gpu, choices[0]);
+        NeuralEvaluator split(*ctx, gpu, choices[0], 3);
+        const std::vector<GpuNeuralHit> a = fused.evaluate(qs), b = split.evaluate(qs);
+        ASSERT_EQ(a.size(), b.size());
+        size_t differ = 0;
+        for (size_t i = 0; i < a.size(); ++i) differ += std::memcmp(&a[i], &b[i], sizeof(GpuNeuralHit)) != 0;
+        EXPECT_EQ(differ, 0u) << "of " << a.size() << " split hits differ from the fused kernel's";
     }
     EXPECT_EQ(ctx->validation_message_count(), 0);
 }

@@ -1,0 +1,24 @@
+// Body of passes/neural_eval_gather.comp, the flat-list form of the split query's gather pass
+// (passes/neural_gather.comp): the hash-grid features of each query's 3 segment points, written as 24
+// fp16 quads (point-major, then level) to the features buffer, quad s of query i at s * count + i
+// (coalesced stores); passes/neural_eval_mlp32.comp runs the MLP on them. For the benchmark and tests.
+#define NB_COOP_ACC_BITS 32 // the paired-lane gather of lib/neural_grid.glsl
+#include "lib/neural_eval_common.glsl"
+layout(set = 0, binding = NB_NEVAL_BIND_FEATURES, std430) writeonly buffer FeatureBuffer { uvec2 split_features[]; };
+#include "lib/neural_grid.glsl"
+
+layout(local_size_x = NB_NEURAL_GROUP) in;
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    bool valid = i < pc.count;
+    GpuNeuralQuery q;
+    q.origin = vec3(0.0f);
+    q.dir = vec3(0.0f, 0.0f, 1.0f);
+    q.t_entry = 0.0f;
+    q.t_exit = 0.0f;
+    if (valid) q = queries[i];
+    vec3 p0, p1, p2;
+    nb_segment_points(pc.box, q.origin, q.dir, q.t_entry, q.t_exit, p0, p1, p2);
+    NB_PAIRED_GATHER_SEGMENT(p0, p1, p2, if (valid) split_features[nb_split_index(i, k * NB_GRID_MAX_LEVELS + l)] = nb_split_quad(f);)
+}
