@@ -131,7 +131,7 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
     const NeuralStage stage(*ctx, *o.model, scene, o, 1);
     NeuralPlan p;
     p.kernel = stage.query_description();
-    p.split_query = stage.split_chunks() > 0;
+    p.split_query = stage.split();
     p.query_shader = stage.query_shader();
     p.lod_primary = stage.params().lod_primary;
     p.lod_secondary = stage.params().lod_secondary;

@@ -117,29 +117,24 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
         const uint64_t bytes = limits.device_local_bytes
                                    ? std::min(limits.buffer_bytes, limits.device_local_bytes / 8)
                                    : limits.buffer_bytes;
-        const SplitPlan plan = plan_split_query(uint64_t(params_.leaves_per_round) * std::max(capacity_, 1u),
-                                                bytes, o.split_chunk_limit);
-        params_.split_chunk = plan.chunk;
-        split_chunks_ = plan.chunks;
+        const uint64_t pairs = uint64_t(params_.leaves_per_round) * std::max(capacity_, 1u);
+        params_.split_chunk = plan_split_query(pairs, bytes, o.split_chunk_limit);
+        split_overflow_ = params_.split_chunk > 0 && params_.split_chunk < pairs;
     }
 }
 
-SplitPlan plan_split_query(uint64_t pairs_per_half, uint64_t buffer_bytes, uint64_t limit) {
+uint32_t plan_split_query(uint64_t pairs_per_half, uint64_t buffer_bytes, uint64_t limit) {
     constexpr uint64_t quad_bytes = 8ull * NB_SPLIT_FEATURE_QUADS;
     const uint64_t group = NB_NEURAL_GROUP;
     uint64_t fit = buffer_bytes / quad_bytes / group * group;
     if (limit > 0) fit = std::min(fit, limit / group * group);
     const uint64_t wanted = (std::max<uint64_t>(pairs_per_half, 1) + group - 1) / group * group;
-    const uint64_t chunk = std::min(fit, wanted);
-    if (chunk == 0) return {};
-    const uint64_t chunks = (wanted + chunk - 1) / chunk;
-    if (chunks > NB_SPLIT_MAX_CHUNKS || chunk * NB_SPLIT_MAX_CHUNKS > 0xFFFFFFFFull) return {};
-    return {uint32_t(chunk), uint32_t(chunks)};
+    return uint32_t(std::min({fit, wanted, uint64_t(0xFFFFFFFFull) / group * group}));
 }
 
 std::string NeuralStage::query_description() const {
     std::string d = kernel_.describe();
-    if (split_chunks_ == 0) return d;
+    if (!split()) return d;
     return d.substr(0, d.find(" (")) + " (split: gather pass + MLP pass, 64 queries per workgroup)";
 }
 
@@ -248,7 +243,7 @@ void NeuralStage::install(std::vector<vk::Buffer>& buffers) {
                                                   VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, "neural counters");
     buffers[NB_BIND_NEURAL_STATE].fill(0u);
     buffers[NB_BIND_NEURAL_COUNTERS].fill(0u);
-    if (split_chunks_ > 0)
+    if (split())
         split_features_ = vk::Buffer(ctx_, uint64_t(params_.split_chunk) * 8u * NB_SPLIT_FEATURE_QUADS,
                                      vk::MemoryKind::device, 0, "split query features");
 }

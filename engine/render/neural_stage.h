@@ -130,10 +130,12 @@ public:
 
     const NeuralKernelChoice& kernel() const { return kernel_; }
     const char* query_shader() const;
-    // The split query pass (NeuralRenderOptions::split_query, where the kernel allows): chunks of the
-    // round's pairs recorded per round (0: the fused pass), and the features buffer they share (bound at
-    // NB_BIND_OUTPUT in the split passes' descriptor sets, lib/bindings.glsl).
-    uint32_t split_chunks() const { return split_chunks_; }
+    // The split query pass (NeuralRenderOptions::split_query, where the kernel allows): whether it runs,
+    // whether a round can hold more pairs than its features buffer (the fused pass then takes the rest:
+    // NB_QUERY_MODE_OVERFLOW), and that buffer (bound at NB_BIND_OUTPUT in the split passes' descriptor
+    // sets, lib/bindings.glsl).
+    bool split() const { return params_.split_chunk > 0; }
+    bool split_overflow() const { return split_overflow_; }
     const vk::Buffer& split_features() const { return split_features_; }
     std::string query_description() const;
     uint32_t rounds() const { return rounds_; }
@@ -158,18 +160,14 @@ private:
     uint32_t rounds_ = 0;
     uint32_t batched_ = 0;
     uint32_t capacity_ = 0;
-    uint32_t split_chunks_ = 0;
+    bool split_overflow_ = false;
     vk::Buffer split_features_;
 };
 
-// Pairs per chunk of the split query pass and chunks per round for `pairs_per_half` pairs (a pending
-// half's capacity) with buffers of at most `buffer_bytes`: a multiple of NB_NEURAL_GROUP pairs whose
-// features fit one buffer (and, when `limit` > 0, at most `limit` rounded down to that multiple);
-// {0, 0} (the fused pass) when more than NB_SPLIT_MAX_CHUNKS chunks would be needed.
-struct SplitPlan {
-    uint32_t chunk = 0;
-    uint32_t chunks = 0;
-};
-SplitPlan plan_split_query(uint64_t pairs_per_half, uint64_t buffer_bytes, uint64_t limit = 0);
+// Pairs of a round the split query pass takes (GpuNeuralParams::split_chunk) for `pairs_per_half` pairs
+// (a pending half's capacity) with buffers of at most `buffer_bytes`: all of them rounded up to a
+// multiple of NB_NEURAL_GROUP, or the most such a multiple whose features fit one buffer (and, when
+// `limit` > 0, at most `limit`); 0 (the fused pass) when not one workgroup's features fit.
+uint32_t plan_split_query(uint64_t pairs_per_half, uint64_t buffer_bytes, uint64_t limit = 0);
 
 } // namespace nbvh::render

@@ -33,7 +33,7 @@ enum Pass : size_t {
     NEURAL_SHADOW,
     NEURAL_TAIL, // hybrid renders only (neural_stage.h)
     NEURAL_GATHER,
-    NEURAL_MLP, // the split query pass only (NeuralStage::split_chunks)
+    NEURAL_MLP, // the split query pass only (NeuralStage::split)
     PASS_COUNT
 };
 // NEURAL_QUERY's shader depends on the MLP path (NeuralStage::query_shader); this entry names its timer.
@@ -216,7 +216,7 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
         const bool split_pass = i == NEURAL_GATHER || i == NEURAL_MLP;
         if (((i == SHADOW || i == NEURAL_SHADOW) && !features_.has_lights()) ||
             (i >= NEURAL_TRAVERSE && !neural_) ||
-            (split_pass && (!neural_ || neural_->split_chunks() == 0))) {
+            (split_pass && (!neural_ || !neural_->split()))) {
             pipelines_.emplace_back();
             sets_.emplace_back();
             continue; // no shadow pass without anything to sample
@@ -276,7 +276,7 @@ void WavefrontRenderer::make_timer() {
                                                            wave_samples_, std::max(wave_samples_, MAX_SAMPLES_PER_SUBMISSION)));
     const uint32_t waves = (samples_per_submission_ + wave_samples_ - 1) / wave_samples_;
     // A round: args, query (split: gather and MLP per chunk), traversal; for path and shadow rays.
-    const uint32_t query_passes = neural_ && neural_->split_chunks() ? 2 * neural_->split_chunks() : 1;
+    const uint32_t query_passes = std::max(neural_query_passes(), 1u);
     const uint32_t per_round = 2 * (2 + query_passes);
     const uint32_t per_wave =
         2 + (8 + (neural_ ? per_round * neural_->batched_rounds() + 8 : 0)) * options_.max_depth;
@@ -362,8 +362,10 @@ void WavefrontRenderer::record_pass(vk::CommandBuffer& cmd, size_t pass, const G
         cmd.dispatch_indirect(buffers_[NB_BIND_COUNTERS], NB_COUNTERS_PENDING_DISPATCH_OFFSET);
         break;
     case Dispatch::indirect_split:
-        cmd.dispatch_indirect(buffers_[NB_BIND_NEURAL_COUNTERS],
-                              NB_NEURAL_SPLIT_DISPATCH_OFFSET + uint32_t(items) * sizeof(GpuDispatchArgs));
+        cmd.dispatch_indirect(buffers_[NB_BIND_NEURAL_COUNTERS], NB_NEURAL_SPLIT_DISPATCH_OFFSET);
+        break;
+    case Dispatch::indirect_overflow:
+        cmd.dispatch_indirect(buffers_[NB_BIND_NEURAL_COUNTERS], NB_NEURAL_OVERFLOW_DISPATCH_OFFSET);
         break;
     }
     cmd.end_pass();
@@ -394,21 +396,24 @@ void WavefrontRenderer::record_neural_rounds(vk::CommandBuffer& cmd, size_t trav
     record_pass(cmd, NEURAL_TAIL, constants(q, depth, w, (batched & 1u) << 2), Dispatch::indirect_pending);
 }
 
-uint32_t WavefrontRenderer::neural_split_chunks() const { return neural_ ? neural_->split_chunks() : 0u; }
+uint32_t WavefrontRenderer::neural_query_passes() const {
+    if (!neural_) return 0;
+    return neural_->split() ? (neural_->split_overflow() ? 3 : 2) : 1;
+}
 
 void WavefrontRenderer::record_query(vk::CommandBuffer& cmd, const GpuPassConstants& pc) {
-    const uint32_t chunks = neural_->split_chunks();
-    if (chunks == 0) {
+    if (!neural_->split()) {
         record_pass(cmd, NEURAL_QUERY, pc, Dispatch::indirect_pending);
         return;
     }
-    // Chunk c: pairs [c * split_chunk, ...) of the round (neural_args wrote each chunk's dispatch; the
-    // chunks past the round's pairs dispatch no workgroup). The features buffer holds one chunk.
-    for (uint32_t c = 0; c < chunks; ++c) {
-        GpuPassConstants chunk_pc = pc;
-        chunk_pc.mode |= c << NB_SPLIT_CHUNK_SHIFT;
-        record_pass(cmd, NEURAL_GATHER, chunk_pc, Dispatch::indirect_split, c);
-        record_pass(cmd, NEURAL_MLP, chunk_pc, Dispatch::indirect_split, c);
+    // The round's first split_chunk pairs (neural_args wrote the dispatches); where a round can hold
+    // more than the features buffer, the fused pass takes the rest (none in most rounds).
+    record_pass(cmd, NEURAL_GATHER, pc, Dispatch::indirect_split);
+    record_pass(cmd, NEURAL_MLP, pc, Dispatch::indirect_split);
+    if (neural_->split_overflow()) {
+        GpuPassConstants rest = pc;
+        rest.mode |= NB_QUERY_MODE_OVERFLOW;
+        record_pass(cmd, NEURAL_QUERY, rest, Dispatch::indirect_overflow);
     }
 }
 

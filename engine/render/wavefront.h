@@ -158,8 +158,9 @@ public:
     // Closest hits of world-space rays (org, dir; t in [tmin, inf)) through passes/traverse.comp, or, in
     // a hybrid renderer, through the same neural rounds as camera rays (primary LoD, leaf budget and
     // leaves per round of the options): triangles and neural leaves, closest accepted hit.
-    // Chunks per round of the split query pass (0: the fused pass, or no model).
-    uint32_t neural_split_chunks() const;
+    // Query passes per round: 1 (the fused pass), 2 (the split pass's gather and MLP passes) or 3 (and the
+    // fused pass for the pairs past the split pass's features buffer); 0 without a model.
+    uint32_t neural_query_passes() const;
     std::vector<TraceHit> trace(const std::vector<glm::vec3>& origins, const std::vector<glm::vec3>& dirs, float tmin = 0.0f);
 
 private:
@@ -168,11 +169,12 @@ private:
         uint32_t sample = 0, samples = 1, offset = 0, count = 0;
     };
     GpuPassConstants constants(uint32_t queue, uint32_t depth, const Wave& w, uint32_t mode) const;
-    // indirect_split: chunk `items` of the split query pass (GpuNeuralCounters::split_dispatch).
-    enum class Dispatch { items, single, indirect_rays, indirect_shadow, indirect_pending, indirect_split };
+    // indirect_split / indirect_overflow: GpuNeuralCounters::split_dispatch / overflow_dispatch.
+    enum class Dispatch { items, single, indirect_rays, indirect_shadow, indirect_pending, indirect_split, indirect_overflow };
     void record_pass(vk::CommandBuffer& cmd, size_t pass, const GpuPassConstants& pc, Dispatch dispatch,
                      uint64_t items = 0);
-    // The query pass of one round: fused, or the split pass's gather and MLP passes chunk by chunk.
+    // The query pass of one round: fused, or the split pass's gather and MLP passes (and the fused pass
+    // for the pairs past the split pass's features buffer).
     void record_query(vk::CommandBuffer& cmd, const GpuPassConstants& pc);
     void record_sample_wave(vk::CommandBuffer& cmd, const Wave& w);
     void record_neural_rounds(vk::CommandBuffer& cmd, size_t traverse_pass, uint32_t q, uint32_t depth, const Wave& w);

@@ -1,7 +1,7 @@
 // Body of passes/neural_query_coop{16,32}.comp: the neural query pass through the fused
 // cooperative-matrix MLP (64 pairs per workgroup; the includer defines NB_COOP_ACC_BITS), and of
 // passes/neural_query_mlp32.comp (NB_SPLIT_FEATURES: the split query's MLP pass, the features read from
-// the buffer passes/neural_gather.comp wrote for chunk nb_split_chunk() of the round's pairs).
+// the buffer passes/neural_gather.comp wrote for the round's first split_chunk pairs).
 #include "lib/bindings.glsl"
 #define NB_NEURAL_MLP_AS_TILES 1
 #include "lib/neural_bindings.glsl"
@@ -14,10 +14,10 @@ layout(local_size_x = NB_NEURAL_GROUP) in;
 void main() {
 #ifdef NB_SPLIT_FEATURES
     uint k = gl_GlobalInvocationID.x;
-    NbPendingQuery r = nb_load_pending(nb_split_chunk() * neural_params.split_chunk + k);
+    NbPendingQuery r = nb_load_pending(k);
     nb_coop_stage_split_features(gl_LocalInvocationID.x, r.valid, k);
 #else
-    NbPendingQuery r = nb_load_pending(gl_GlobalInvocationID.x);
+    NbPendingQuery r = nb_load_pending(nb_query_first_pair() + gl_GlobalInvocationID.x);
     vec3 p0, p1, p2;
     nb_segment_points(neural_params.box, r.org, r.dir, r.pl.t_enter, r.pl.t_exit, p0, p1, p2);
     nb_coop_stage_features(gl_LocalInvocationID.x, r.valid, p0, p1, p2);

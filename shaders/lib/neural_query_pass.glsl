@@ -14,8 +14,9 @@ struct NbPendingQuery {
     vec3 dir;
 };
 
-// Chunk of the round's pairs a split query pass takes (pass-constant mode bits 4-5, shared/neural_gpu.h).
-uint nb_split_chunk() { return (pc.mode >> NB_SPLIT_CHUNK_SHIFT) & (NB_SPLIT_MAX_CHUNKS - 1u); }
+// First pair of the round a query pass takes: 0, or for the fused pass after the split pass the pairs
+// past its features buffer (NB_QUERY_MODE_OVERFLOW, shared/neural_gpu.h).
+uint nb_query_first_pair() { return (pc.mode & NB_QUERY_MODE_OVERFLOW) != 0u ? neural_params.split_chunk : 0u; }
 
 // Pair k of pending half nb_nl_half(pc.mode) (neural_traverse.glsl). Rays >= capacity are shadow
 // rays (shadow SOA index ray - capacity), the others path rays of queue pc.in_queue.

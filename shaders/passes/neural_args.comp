@@ -1,7 +1,7 @@
 // One invocation between a neural traversal round and the neural query pass: hands the pairs queued so
 // far to the query pass (pending_active), empties the queue for the next round, writes the indirect
-// dispatch arguments (NB_NEURAL_GROUP pairs per workgroup; the split query pass: per chunk of
-// neural_params.split_chunk pairs) and counts queries for --stats.
+// dispatch arguments (NB_NEURAL_GROUP pairs per workgroup; the split query pass: its first
+// neural_params.split_chunk pairs, and the rest for the fused pass) and counts queries for --stats.
 #version 460
 #include "lib/bindings.glsl"
 #include "lib/neural_bindings.glsl"
@@ -18,12 +18,11 @@ void main() {
     counters.pending_dispatch.x = (n + NB_NEURAL_GROUP - 1u) / NB_NEURAL_GROUP;
     counters.pending_dispatch.y = 1u;
     counters.pending_dispatch.z = 1u;
-    uint chunk = neural_params.split_chunk;
-    for (uint c = 0u; c < NB_SPLIT_MAX_CHUNKS; ++c) {
-        uint first = c * chunk; // no wrap: chunk * NB_SPLIT_MAX_CHUNKS < 2^32 (neural_stage.cpp)
-        uint pairs = chunk == 0u || n <= first ? 0u : min(n - first, chunk);
-        neural_counters.split_dispatch[c].x = (pairs + NB_NEURAL_GROUP - 1u) / NB_NEURAL_GROUP;
-        neural_counters.split_dispatch[c].y = 1u;
-        neural_counters.split_dispatch[c].z = 1u;
-    }
+    uint split = min(n, neural_params.split_chunk);
+    neural_counters.split_dispatch.x = (split + NB_NEURAL_GROUP - 1u) / NB_NEURAL_GROUP;
+    neural_counters.split_dispatch.y = 1u;
+    neural_counters.split_dispatch.z = 1u;
+    neural_counters.overflow_dispatch.x = (n - split + NB_NEURAL_GROUP - 1u) / NB_NEURAL_GROUP;
+    neural_counters.overflow_dispatch.y = 1u;
+    neural_counters.overflow_dispatch.z = 1u;
 }

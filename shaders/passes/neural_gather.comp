@@ -1,5 +1,5 @@
 // The split query's gather pass (shared/neural_gpu.h NB_SPLIT_*): the hash-grid features of the 3
-// segment points of each pair of one chunk of the round's pairs, stored as 24 fp16 quads for
+// segment points of each of the round's first split_chunk pairs, stored as 24 fp16 quads for
 // passes/neural_query_mlp32.comp. Without the MLP this kernel needs few registers, so many more
 // subgroups per SM hide the gathers' latency than in the fused pass (H200: results/neural/README.md).
 #version 460
@@ -14,8 +14,8 @@
 layout(local_size_x = NB_NEURAL_GROUP) in;
 
 void main() {
-    uint pair = gl_GlobalInvocationID.x; // in the chunk
-    NbPendingQuery r = nb_load_pending(nb_split_chunk() * neural_params.split_chunk + pair);
+    uint pair = gl_GlobalInvocationID.x;
+    NbPendingQuery r = nb_load_pending(pair);
     vec3 p0, p1, p2;
     nb_segment_points(neural_params.box, r.org, r.dir, r.pl.t_enter, r.pl.t_exit, p0, p1, p2);
     // Every lane gathers (the lane pairs shuffle), only valid pairs store.

@@ -59,7 +59,7 @@ NB_STATIC_ASSERT(sizeof(GpuNeuralEvalPush) == 48, "GpuNeuralEvalPush layout");
 #define NB_NEVAL_BIND_MLP 2u      // uint[]: fp16 pairs, NB_MLP_WEIGHT_COUNT / 2 words (coopmat: transposed)
 #define NB_NEVAL_BIND_QUERIES 3u  // GpuNeuralQuery[]
 #define NB_NEVAL_BIND_HITS 4u     // GpuNeuralHit[]
-#define NB_NEVAL_BIND_FEATURES 5u // uvec2[]: split kernels' features, quad s of query i at s * count + i
+#define NB_NEVAL_BIND_FEATURES 5u // uvec2[]: split kernels' features (nb_split_index)
 
 // Leaf interval of a query (official notes §1): the slab interval of the ray with the leaf box dilated
 // by NB_LEAF_DILATION of its extent about its centre (as the trainer's dilate_box), with
@@ -169,7 +169,8 @@ struct GpuNeuralParams {
     uint material_fits;
     // 1: a hit's metallic/roughness also takes the fit's spread (nb_node_fit_spread), --neural-materials mix.
     uint material_spread;
-    // Pairs per chunk of the split query pass (its features buffer's capacity); 0: the fused query pass.
+    // Pairs of a round the split query pass takes (its features buffer's capacity); the fused pass
+    // takes the rest (NB_QUERY_MODE_OVERFLOW). 0: the fused pass takes every pair.
     uint split_chunk;
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 80, "GpuNeuralParams layout");
@@ -201,12 +202,11 @@ NB_FN vec2 nb_node_fit_spread(vec2 fit, vec2 spread, uint random_bits) {
 // The split query pass (engine/render/neural_stage.h NeuralRenderOptions::split_query): a gather pass
 // (passes/neural_gather.comp) writes each pair's 96 features as NB_SPLIT_FEATURE_QUADS fp16 quads to a
 // features buffer (nb_split_index: blocks of NB_NEURAL_GROUP pairs, quad-major inside a block), then an MLP
-// pass (passes/neural_query_mlp32.comp) reads them. The buffer holds split_chunk pairs (one binding); a
-// round's pairs are taken in up to NB_SPLIT_MAX_CHUNKS chunks (chunk index in pass-constant mode bits
-// 4-5, NB_SPLIT_CHUNK_SHIFT).
-#define NB_SPLIT_MAX_CHUNKS 4u
+// pass (passes/neural_query_mlp32.comp) reads them. The buffer holds split_chunk pairs (one binding);
+// a round with more pairs than that (a pending half can hold more) gives the rest to the fused query
+// pass, dispatched after them with NB_QUERY_MODE_OVERFLOW (its pairs start at split_chunk).
 #define NB_SPLIT_FEATURE_QUADS 24u // NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS, 8 bytes each
-#define NB_SPLIT_CHUNK_SHIFT 4u
+#define NB_QUERY_MODE_OVERFLOW 16u // pass-constant mode bit of the fused query pass (bits 0-3: neural_traverse.glsl)
 
 // Quad s of pair k (in its chunk) in the features buffer, in quads: each workgroup's NB_NEURAL_GROUP
 // pairs own one contiguous block (12 KiB), quad-major inside it, so a subgroup's stores and loads of a
@@ -235,14 +235,16 @@ struct GpuNeuralCounters {
     // summed in 64 bits after every submission; a bounce's queries in one submission stay below 2^32:
     // wave_plan.h bounds the leaves queued per wave).
     uint queries_by_depth[NB_STAT_DEPTHS];
-    // Split query pass (GpuNeuralParams::split_chunk > 0): the indirect dispatch of chunk c of the
-    // round's pairs (passes/neural_args.comp), for its gather pass and its MLP pass alike.
-    GpuDispatchArgs split_dispatch[NB_SPLIT_MAX_CHUNKS];
+    // Split query pass (GpuNeuralParams::split_chunk > 0), written by passes/neural_args.comp: the
+    // indirect dispatch of the round's first split_chunk pairs (gather and MLP pass alike), and of the
+    // rest through the fused pass.
+    GpuDispatchArgs split_dispatch;
+    GpuDispatchArgs overflow_dispatch;
 };
-NB_STATIC_ASSERT(sizeof(GpuNeuralCounters) == 32 + 4 * NB_STAT_DEPTHS + 12 * NB_SPLIT_MAX_CHUNKS,
-                 "GpuNeuralCounters layout");
-// Byte offset of split_dispatch[c] (vkCmdDispatchIndirect).
+NB_STATIC_ASSERT(sizeof(GpuNeuralCounters) == 32 + 4 * NB_STAT_DEPTHS + 24, "GpuNeuralCounters layout");
+// Byte offsets of split_dispatch and overflow_dispatch (vkCmdDispatchIndirect).
 #define NB_NEURAL_SPLIT_DISPATCH_OFFSET (32u + 4u * NB_STAT_DEPTHS)
+#define NB_NEURAL_OVERFLOW_DISPATCH_OFFSET (NB_NEURAL_SPLIT_DISPATCH_OFFSET + 12u)
 
 // 64-bit counter (lo, hi) += n in 32-bit words (one writer at a time: passes/neural_args.comp).
 NB_FN void nb_add_u64(NB_INOUT(uint) lo, NB_INOUT(uint) hi, uint n) {

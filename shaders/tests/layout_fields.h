@@ -121,10 +121,8 @@
             F(queries_by_depth[6]) F(queries_by_depth[7]) F(queries_by_depth[8]) F(queries_by_depth[9])      \
                 F(queries_by_depth[10]) F(queries_by_depth[11]) F(queries_by_depth[12])                      \
                     F(queries_by_depth[13]) F(queries_by_depth[14]) F(queries_by_depth[15])                  \
-                        F(split_dispatch[0].x) F(split_dispatch[0].y) F(split_dispatch[0].z)                 \
-                            F(split_dispatch[1].x) F(split_dispatch[1].y) F(split_dispatch[1].z)             \
-                                F(split_dispatch[2].x) F(split_dispatch[2].y) F(split_dispatch[2].z)         \
-                                    F(split_dispatch[3].x) F(split_dispatch[3].y) F(split_dispatch[3].z)
+                        F(split_dispatch.x) F(split_dispatch.y) F(split_dispatch.z)                          \
+                            F(overflow_dispatch.x) F(overflow_dispatch.y) F(overflow_dispatch.z)
 #define NB_LAYOUT_FIELDS_GpuNeuralAsset(F)                                                        \
     F(roots[0]) F(roots[1]) F(roots[2]) F(roots[3]) F(roots[4]) F(roots[5]) F(roots[6]) F(roots[7]) \
     F(material) F(metallic) F(roughness) F(backface_escape)

@@ -2,11 +2,11 @@
 // neural_gpu.h NB_SPLIT_*) against the fused pass in a hybrid render on a GPU with fp32 cooperative
 // matrices (label `gpu`; lavapipe has none, so on CI the test skips). Both passes compute the same
 // features (the same paired gather, the same fp16 rounding) and run the same MLP code on them, so the
-// images must be the same bytes and the queries the same, whether a round's pairs take one chunk of
-// the features buffer or four. A scene built in code (a sphere and a box, neural, on a classical
+// images must be the same bytes and the queries the same, also when a round holds more pairs than the
+// features buffer (the fused pass takes the rest). A scene built in code (a sphere and a box, neural, on a classical
 // ground), a small CPU-trained model (~3 s), 96x64, 4 samples, 3 path segments (camera, secondary and
-// shadow rays through the neural assets). A wrong chunk offset, stride or feature order changes the
-// image (a hit answered with another pair's features).
+// shadow rays through the neural assets). A wrong pair offset or feature order changes the image (a
+// hit answered with another pair's features).
 #include "assets/procedural_mesh.h"
 #include "engine/bvh/scene_accel.h"
 #include "engine/core/error.h"
@@ -65,7 +65,7 @@ struct Frame {
     std::vector<float> pixels;
     RenderStats stats;
     std::string path;
-    uint32_t chunks = 0;
+    uint32_t query_passes = 0;
 };
 
 } // namespace
@@ -110,20 +110,21 @@ TEST(SplitQuery, SameImageAsTheFusedPass) {
         o.neural.split_chunk_limit = limit;
         WavefrontRenderer r(*ctx, scene, accel, default_sky(), scene.camera, o);
         const RenderResult res = r.render();
-        return Frame{res.image.data, res.stats, res.stats.neural_path, r.neural_split_chunks()};
+        return Frame{res.image.data, res.stats, res.stats.neural_path, r.neural_query_passes()};
     };
     const Frame fused = render(false, 0);
     const Frame one = render(true, 0);
-    // 96 x 64 x 4 paths, 2 leaves per round: 49,152 pairs per half, in 4 chunks of 12,800.
-    const Frame four = render(true, 12800);
-    std::printf("fused: %s, %llu queries; split: %s, %u and %u chunks\n", fused.path.c_str(),
-                (unsigned long long)fused.stats.neural_queries, one.path.c_str(), one.chunks, four.chunks);
-    EXPECT_EQ(fused.chunks, 0u);
-    EXPECT_EQ(one.chunks, 1u);
-    EXPECT_EQ(four.chunks, 4u);
+    // 96 x 64 x 4 paths, 2 leaves per round: 49,152 pairs per half, 1,280 of them in the split pass, the
+    // rest of a round's pairs (the first rounds hold several thousand) through the fused pass.
+    const Frame part = render(true, 1280);
+    std::printf("fused: %s, %llu queries; split: %s, %u and %u query passes per round\n", fused.path.c_str(),
+                (unsigned long long)fused.stats.neural_queries, one.path.c_str(), one.query_passes, part.query_passes);
+    EXPECT_EQ(fused.query_passes, 1u);
+    EXPECT_EQ(one.query_passes, 2u);
+    EXPECT_EQ(part.query_passes, 3u);
     EXPECT_NE(one.path.find("split"), std::string::npos);
     EXPECT_GT(fused.stats.neural_queries, 1000u);
-    for (const Frame* f : {&one, &four}) {
+    for (const Frame* f : {&one, &part}) {
         EXPECT_EQ(f->stats.neural_queries, fused.stats.neural_queries);
         EXPECT_EQ(f->stats.rays_shadow, fused.stats.rays_shadow);
         EXPECT_EQ(f->pixels, fused.pixels);

@@ -257,37 +257,28 @@ TEST(PendingPair, RayGroupAndFlagSurviveThePacking) {
     EXPECT_LE(2ull * p.capacity, uint64_t(NB_PAIR_RAY_MASK) + 1u);
 }
 
-// The split query pass's chunks (neural_stage.h plan_split_query): whole workgroups of pairs whose
-// features fit one buffer, enough chunks for a pending half, none beyond NB_SPLIT_MAX_CHUNKS.
-TEST(SplitQueryPlan, ChunksCoverAPendingHalfWithinOneBuffer) {
+// The split query pass's share of a round (neural_stage.h plan_split_query): whole workgroups of pairs
+// whose features fit one buffer, the whole pending half where they fit, never none where one workgroup fits.
+TEST(SplitQueryPlan, TakesAPendingHalfWithinOneBuffer) {
     const uint64_t quad_bytes = 8ull * NB_SPLIT_FEATURE_QUADS;
     const uint64_t nvidia = 4094ull << 20; // the H200's one-buffer bound (wave_limits)
     for (uint64_t pairs : {1ull, 63ull, 64ull, 65ull, 49152ull, 1ull << 22, 2ull * 33177600ull}) {
         for (uint64_t limit : {0ull, 1000ull, 12800ull}) {
-            const SplitPlan p = plan_split_query(pairs, nvidia, limit);
-            if (p.chunks == 0) {
-                EXPECT_EQ(p.chunk, 0u);
-                continue;
-            }
-            EXPECT_EQ(p.chunk % NB_NEURAL_GROUP, 0u) << pairs;
-            EXPECT_LE(uint64_t(p.chunk) * quad_bytes, nvidia) << pairs;
-            if (limit) EXPECT_LE(p.chunk, limit) << pairs;
-            EXPECT_GE(uint64_t(p.chunk) * p.chunks, pairs) << pairs;       // every pair of a full half
-            EXPECT_LT(uint64_t(p.chunk) * (p.chunks - 1), pairs) << pairs; // no chunk that is always empty
-            EXPECT_LE(p.chunks, NB_SPLIT_MAX_CHUNKS) << pairs;
+            const uint64_t chunk = plan_split_query(pairs, nvidia, limit);
+            EXPECT_GT(chunk, 0u) << pairs;
+            EXPECT_EQ(chunk % NB_NEURAL_GROUP, 0u) << pairs;
+            EXPECT_LE(chunk * quad_bytes, nvidia) << pairs;
+            if (limit) EXPECT_LE(chunk, limit) << pairs;
+            EXPECT_LT(chunk, pairs + NB_NEURAL_GROUP) << pairs; // no workgroup past a full half
+            if (chunk < pairs) EXPECT_EQ(chunk, limit ? limit / NB_NEURAL_GROUP * NB_NEURAL_GROUP : nvidia / quad_bytes / NB_NEURAL_GROUP * NB_NEURAL_GROUP);
         }
     }
-    // 16 samples of 1080p at 2 leaves per round: 66M pairs in 3 chunks of 21.8M (4 GiB of features each).
-    const SplitPlan hd = plan_split_query(2ull * 33177600ull, nvidia);
-    EXPECT_EQ(hd.chunks, 3u);
-    EXPECT_EQ(hd.chunk, nvidia / quad_bytes / NB_NEURAL_GROUP * NB_NEURAL_GROUP);
-    // Small pending halves take one chunk of their own size (rounded up to a workgroup).
-    EXPECT_EQ(plan_split_query(65, nvidia).chunk, 128u);
-    EXPECT_EQ(plan_split_query(65, nvidia).chunks, 1u);
-    // More than NB_SPLIT_MAX_CHUNKS chunks: the fused pass (lavapipe's 128 MiB bound, a large wave).
-    EXPECT_EQ(plan_split_query(1ull << 24, 128ull << 20).chunks, 0u);
-    EXPECT_EQ(plan_split_query(1ull << 20, 128ull << 20).chunks, 2u);
-    EXPECT_EQ(plan_split_query(49152, nvidia, 1000).chunks, 0u);  // 49 chunks of 960
-    EXPECT_EQ(plan_split_query(49152, nvidia, 12800).chunks, 4u); // 4 chunks of 12800
-    EXPECT_EQ(plan_split_query(100, nvidia, 10).chunks, 0u);      // below one workgroup
+    // 16 samples of 1080p at 2 leaves per round: 66M pairs, 21.8M of them in 4 GiB of features (the fused
+    // pass takes the rest of a round, which no default render at that size reaches).
+    EXPECT_EQ(plan_split_query(2ull * 33177600ull, nvidia), nvidia / quad_bytes / NB_NEURAL_GROUP * NB_NEURAL_GROUP);
+    EXPECT_EQ(plan_split_query(65, nvidia), 128u); // a small half: all of it, rounded up to a workgroup
+    EXPECT_EQ(plan_split_query(1ull << 24, 128ull << 20), 699008u); // lavapipe's 128 MiB bound
+    EXPECT_EQ(plan_split_query(49152, nvidia, 12800), 12800u);
+    EXPECT_EQ(plan_split_query(100, nvidia, 10), 0u); // not one workgroup: the fused pass
+    EXPECT_EQ(plan_split_query(100, 1000), 0u);
 }
