@@ -36,8 +36,7 @@ std::string neural_rounds_text(const NeuralPlan& n, const char* traverse, const 
         s += strfmt("    repeat %u x (batched rounds):\n", n.batched_rounds);
         s += "      passes/neural_args.comp    queued pairs -> indirect dispatch arguments\n";
         if (n.split_query) {
-            s += "      passes/neural_gather.comp  hash grid of the queued pairs -> features (per chunk; "
-                 "--neural-query)\n";
+            s += "      passes/neural_gather.comp  hash grid of the queued pairs -> features (--neural-query)\n";
             s += "      passes/neural_query_mlp32.comp MLP of those features -> the pairs' hits\n";
         } else {
             s += strfmt("      %-26s hash grid + MLP of the queued pairs\n", n.query_shader.c_str());

@@ -106,20 +106,20 @@ private:
 // Runs the flat-list query kernels.
 class NeuralEvaluator {
 public:
-  // part (cooperative-matrix kernels only, benchmark breakdown): 0 full, 1 features only, 2 MLP only;
-  // the split query (fp32 accumulators): 3 gather kernel then MLP kernel, 4 its gather kernel only,
-  // 5 its MLP kernel only (on the features of the last part 3 or 4 dispatch).
-  NeuralEvaluator(const vk::Context& ctx, const NeuralModelGpu& model, NeuralKernelChoice choice,
-                  uint32_t part = 0);
-  const NeuralKernelChoice& choice() const { return choice_; }
+    // part (cooperative-matrix kernels only, benchmark breakdown): 0 full, 1 features only, 2 MLP only;
+    // the split query (fp32 accumulators): 3 gather kernel then MLP kernel, 4 its gather kernel only,
+    // 5 its MLP kernel only (on the features of the last part 3 or 4 dispatch).
+    NeuralEvaluator(const vk::Context& ctx, const NeuralModelGpu& model, NeuralKernelChoice choice,
+                    uint32_t part = 0);
+    const NeuralKernelChoice& choice() const { return choice_; }
 
-  // Decoded hits of `queries` (object space, this model's encoding box).
-  std::vector<GpuNeuralHit> evaluate(const std::vector<GpuNeuralQuery>& queries,
-                                     float threshold = NB_VISIBILITY_THRESHOLD);
-  // GPU milliseconds of one dispatch over `count` queries already uploaded by evaluate() or
-  // upload_queries() (timestamps; 0 without). For the benchmark.
-  void upload_queries(const std::vector<GpuNeuralQuery>& queries);
-  double time_dispatch(uint32_t count, int repetitions, float threshold = NB_VISIBILITY_THRESHOLD);
+    // Decoded hits of `queries` (object space, this model's encoding box).
+    std::vector<GpuNeuralHit> evaluate(const std::vector<GpuNeuralQuery>& queries,
+                                       float threshold = NB_VISIBILITY_THRESHOLD);
+    // GPU milliseconds of one dispatch over `count` queries already uploaded by evaluate() or
+    // upload_queries() (timestamps; 0 without). For the benchmark.
+    void upload_queries(const std::vector<GpuNeuralQuery>& queries);
+    double time_dispatch(uint32_t count, int repetitions, float threshold = NB_VISIBILITY_THRESHOLD);
 
 private:
     void ensure_capacity(size_t count);

@@ -112,7 +112,7 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
     assets_ = asset_table(model, model_, scene, o);
     if (o.split_query && kernel_.path == NeuralPath::coopmat && kernel_.fp32_accumulate) {
         // The features buffer: one binding, and at most an eighth of the GPU's memory (beside the wave's
-        // queues, a quarter by default): a wave larger than one chunk takes its rounds in chunks.
+        // queues, a quarter by default); the pairs of a round past it go to the fused pass.
         const WaveLimits limits = wave_limits(ctx.features());
         const uint64_t bytes = limits.device_local_bytes
                                    ? std::min(limits.buffer_bytes, limits.device_local_bytes / 8)

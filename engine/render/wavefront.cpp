@@ -275,7 +275,7 @@ void WavefrontRenderer::make_timer() {
                                                                std::max<uint64_t>(pixels, 1),
                                                            wave_samples_, std::max(wave_samples_, MAX_SAMPLES_PER_SUBMISSION)));
     const uint32_t waves = (samples_per_submission_ + wave_samples_ - 1) / wave_samples_;
-    // A round: args, query (split: gather and MLP per chunk), traversal; for path and shadow rays.
+    // A round: args, query (split: gather, MLP and the overflow's fused pass), traversal; path and shadow rays.
     const uint32_t query_passes = std::max(neural_query_passes(), 1u);
     const uint32_t per_round = 2 * (2 + query_passes);
     const uint32_t per_wave =

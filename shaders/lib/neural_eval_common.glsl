@@ -14,4 +14,16 @@ layout(set = 0, binding = NB_NEVAL_BIND_GRID, scalar) readonly buffer GridBuffer
 layout(set = 0, binding = NB_NEVAL_BIND_QUERIES, scalar) readonly buffer QueryBuffer { GpuNeuralQuery queries[]; };
 layout(set = 0, binding = NB_NEVAL_BIND_HITS, scalar) writeonly buffer HitBuffer { GpuNeuralHit hits[]; };
 
+
+// Query i of the list, or a harmless placeholder past its end (the lanes of a partial workgroup still
+// run the subgroup-wide gather and MLP).
+GpuNeuralQuery nb_eval_query(uint i, bool valid) {
+    GpuNeuralQuery q;
+    q.origin = vec3(0.0f);
+    q.dir = vec3(0.0f, 0.0f, 1.0f);
+    q.t_entry = 0.0f;
+    q.t_exit = 0.0f;
+    if (valid) q = queries[i];
+    return q;
+}
 #endif

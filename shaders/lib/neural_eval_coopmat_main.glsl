@@ -19,12 +19,7 @@ void main() {
     uint i = gl_GlobalInvocationID.x;
     uint local = gl_LocalInvocationID.x;
     bool valid = i < pc.count;
-    GpuNeuralQuery q;
-    q.origin = vec3(0.0f);
-    q.dir = vec3(0.0f, 0.0f, 1.0f);
-    q.t_entry = 0.0f;
-    q.t_exit = 0.0f;
-    if (valid) q = queries[i];
+    GpuNeuralQuery q = nb_eval_query(i, valid);
     vec3 p0, p1, p2;
     nb_segment_points(pc.box, q.origin, q.dir, q.t_entry, q.t_exit, p0, p1, p2);
     if (NB_EVAL_PART == 2u) {

@@ -12,12 +12,7 @@ layout(local_size_x = NB_NEURAL_GROUP) in;
 void main() {
     uint i = gl_GlobalInvocationID.x;
     bool valid = i < pc.count;
-    GpuNeuralQuery q;
-    q.origin = vec3(0.0f);
-    q.dir = vec3(0.0f, 0.0f, 1.0f);
-    q.t_entry = 0.0f;
-    q.t_exit = 0.0f;
-    if (valid) q = queries[i];
+    GpuNeuralQuery q = nb_eval_query(i, valid);
     vec3 p0, p1, p2;
     nb_segment_points(pc.box, q.origin, q.dir, q.t_entry, q.t_exit, p0, p1, p2);
     NB_PAIRED_GATHER_SEGMENT(p0, p1, p2, if (valid) split_features[nb_split_index(i, k * NB_GRID_MAX_LEVELS + l)] = nb_split_quad(f);)
