@@ -85,6 +85,7 @@ nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o
                                      : n.materials == render::NeuralMaterials::node ? "node"
                                                                                      : "asset"},
                        {"backface_escape", n.backface_escape},
+                       {"query", n.split_query ? "split" : "fused"}, // requested; neural.path says what ran
                        {"roughness_override", n.roughness},
                        {"metallic_override", n.metallic}};
     }
