@@ -105,18 +105,20 @@ void apply_classical_materials(const Scene& scene, GpuSceneData& data, float rou
 }
 
 NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const Scene& scene,
-                         const NeuralRenderOptions& o, uint32_t ray_capacity)
+                         const NeuralRenderOptions& o, uint32_t ray_capacity, float memory_share)
     : ctx_(ctx), model_(ctx, model), kernel_(choose_neural_kernel(ctx.features(), o.path)),
       rounds_(o.max_rounds), capacity_(ray_capacity) {
     set_params(o);
     assets_ = asset_table(model, model_, scene, o);
     if (o.split_query && kernel_.path == NeuralPath::coopmat && kernel_.fp32_accumulate) {
-        // The features buffer: one binding, and at most an eighth of the GPU's memory (beside the wave's
-        // queues, a quarter by default); the pairs of a round past it go to the fused pass.
+        // The features buffer: one binding, and at most half the renderer's memory share (an eighth of the
+        // GPU's memory by default, beside its queues' quarter); the pairs of a round past it go to the
+        // fused pass.
         const WaveLimits limits = wave_limits(ctx.features());
-        const uint64_t bytes = limits.device_local_bytes
-                                   ? std::min(limits.buffer_bytes, limits.device_local_bytes / 8)
-                                   : limits.buffer_bytes;
+        const uint64_t share =
+            uint64_t(double(limits.device_local_bytes) * std::clamp(memory_share, 0.0f, 1.0f) * 0.5);
+        const uint64_t bytes =
+            limits.device_local_bytes ? std::min(limits.buffer_bytes, share) : limits.buffer_bytes;
         const uint64_t pairs = uint64_t(params_.leaves_per_round) * std::max(capacity_, 1u);
         params_.split_chunk = plan_split_query(pairs, bytes, o.split_chunk_limit);
         split_overflow_ = params_.split_chunk > 0 && params_.split_chunk < pairs;

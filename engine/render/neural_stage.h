@@ -106,8 +106,11 @@ void apply_classical_materials(const Scene& scene, GpuSceneData& data, float rou
 
 class NeuralStage {
 public:
-    NeuralStage(const vk::Context& ctx, const NeuralModel& model, const Scene& scene, const NeuralRenderOptions& options,
-                uint32_t ray_capacity);
+    // memory_share: the renderer's RenderOptions::wave_memory_share; the split query's features buffer
+    // takes at most half of it (a renderer's queues take the share, several renderers held at once
+    // divide it between them: nbvh study).
+    NeuralStage(const vk::Context& ctx, const NeuralModel& model, const Scene& scene,
+                const NeuralRenderOptions& options, uint32_t ray_capacity, float memory_share = 0.25f);
 
     // New per-render neural settings (LoDs, overrides, leaf budget, batched rounds, threshold) written
     // into the params buffer. Leaves per round cannot change here.

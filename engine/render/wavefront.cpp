@@ -186,7 +186,8 @@ WavefrontRenderer::WavefrontRenderer(const vk::Context& ctx, const Scene& scene,
         vk::Buffer(ctx_, sizeof(GpuPendingLeaf), vk::MemoryKind::device, 0, "pending leaves");
     NeuralStage::install_placeholders(ctx_, buffers_);
     if (features_.neural) {
-        neural_ = std::make_unique<NeuralStage>(ctx_, *nopt.model, scene, nopt, capacity_);
+        neural_ = std::make_unique<NeuralStage>(ctx_, *nopt.model, scene, nopt, capacity_,
+                                                options_.wave_memory_share);
         neural_->install(buffers_);
     }
     buffers_[NB_BIND_OUTPUT] = vk::Buffer(ctx_, pixels * sizeof(vec4), vk::MemoryKind::device, 0, "output");
