@@ -1,7 +1,7 @@
 // Body of passes/neural_eval_gather.comp, the flat-list form of the split query's gather pass
 // (passes/neural_gather.comp): the hash-grid features of each query's 3 segment points, written as 24
-// fp16 quads (point-major, then level) to the features buffer, quad s of query i at s * count + i
-// (coalesced stores); passes/neural_eval_mlp32.comp runs the MLP on them. For the benchmark and tests.
+// fp16 quads (point-major, then level) to the features buffer at nb_split_index (shared/neural_gpu.h);
+// passes/neural_eval_mlp32.comp runs the MLP on them. For the benchmark and tests.
 #define NB_COOP_ACC_BITS 32 // the paired-lane gather of lib/neural_grid.glsl
 #include "lib/neural_eval_common.glsl"
 layout(set = 0, binding = NB_NEVAL_BIND_FEATURES, std430) writeonly buffer FeatureBuffer { uvec2 split_features[]; };

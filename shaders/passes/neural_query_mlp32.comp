@@ -1,5 +1,5 @@
 // The split query's MLP pass: the fused cooperative-matrix MLP (fp32 accumulators, NB_COOP_FAST) on
-// the features passes/neural_gather.comp wrote for one chunk of the round's pairs, then the decode and
+// the features passes/neural_gather.comp wrote for the round's first split_chunk pairs, then the decode and
 // the pair's result as in the fused pass (lib/neural_query_coopmat_main.glsl).
 #version 460
 #define NB_COOP_ACC_BITS 32

@@ -208,10 +208,10 @@ NB_FN vec2 nb_node_fit_spread(vec2 fit, vec2 spread, uint random_bits) {
 #define NB_SPLIT_FEATURE_QUADS 24u // NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS, 8 bytes each
 #define NB_QUERY_MODE_OVERFLOW 16u // pass-constant mode bit of the fused query pass (bits 0-3: neural_traverse.glsl)
 
-// Quad s of pair k (in its chunk) in the features buffer, in quads: each workgroup's NB_NEURAL_GROUP
+// Quad s of the round's pair k (k < split_chunk) in the features buffer, in quads: each workgroup's NB_NEURAL_GROUP
 // pairs own one contiguous block (12 KiB), quad-major inside it, so a subgroup's stores and loads of a
 // quad are 256 contiguous bytes and a pair's 24 quads lie in one block. (Quad-major over the whole
-// chunk put a pair's quads 174 MB apart in a 4 GB buffer.)
+// buffer put a pair's quads 174 MB apart in a 4 GB buffer.)
 NB_FN uint nb_split_index(uint k, uint s) {
     return (k / NB_NEURAL_GROUP) * (NB_NEURAL_GROUP * NB_SPLIT_FEATURE_QUADS) + s * NB_NEURAL_GROUP +
            k % NB_NEURAL_GROUP;

@@ -3,7 +3,7 @@
 // matrices (label `gpu`; lavapipe has none, so on CI the test skips). Both passes compute the same
 // features (the same paired gather, the same fp16 rounding) and run the same MLP code on them, so the
 // images must be the same bytes and the queries the same, also when a round holds more pairs than the
-// features buffer (the fused pass takes the rest). A scene built in code (a sphere and a box, neural, on a classical
+// features buffer (the fused pass takes the rest: a buffer of 64 pairs here). A scene built in code (a sphere and a box, neural, on a classical
 // ground), a small CPU-trained model (~3 s), 96x64, 4 samples, 3 path segments (camera, secondary and
 // shadow rays through the neural assets). A wrong pair offset or feature order changes the image (a
 // hit answered with another pair's features).
@@ -114,9 +114,9 @@ TEST(SplitQuery, SameImageAsTheFusedPass) {
     };
     const Frame fused = render(false, 0);
     const Frame one = render(true, 0);
-    // 96 x 64 x 4 paths, 2 leaves per round: 49,152 pairs per half, 1,280 of them in the split pass, the
-    // rest of a round's pairs (the first rounds hold several thousand) through the fused pass.
-    const Frame part = render(true, 1280);
+    // 96 x 64 x 4 paths, 2 leaves per round: 49,152 pairs per half, 64 of them (one workgroup) in the
+    // split pass, the rest of a round's pairs through the fused pass (NB_QUERY_MODE_OVERFLOW).
+    const Frame part = render(true, 64);
     std::printf("fused: %s, %llu queries; split: %s, %u and %u query passes per round\n", fused.path.c_str(),
                 (unsigned long long)fused.stats.neural_queries, one.path.c_str(), one.query_passes, part.query_passes);
     EXPECT_EQ(fused.query_passes, 1u);
@@ -124,6 +124,9 @@ TEST(SplitQuery, SameImageAsTheFusedPass) {
     EXPECT_EQ(part.query_passes, 3u);
     EXPECT_NE(one.path.find("split"), std::string::npos);
     EXPECT_GT(fused.stats.neural_queries, 1000u);
+    // More queries than 64 per round on average: some round held more pairs than the split pass took,
+    // so the overflow's fused dispatch had work.
+    EXPECT_GT(fused.stats.neural_queries, 64u * fused.stats.neural_rounds);
     for (const Frame* f : {&one, &part}) {
         EXPECT_EQ(f->stats.neural_queries, fused.stats.neural_queries);
         EXPECT_EQ(f->stats.rays_shadow, fused.stats.rays_shadow);
