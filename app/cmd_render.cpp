@@ -83,9 +83,10 @@ nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o
                        {"materials", n.materials == render::NeuralMaterials::mix    ? "mix"
                                      : n.materials == render::NeuralMaterials::fit  ? "fit"
                                      : n.materials == render::NeuralMaterials::node ? "node"
-                                                                                     : "asset"},
+                                                                                    : "asset"},
                        {"backface_escape", n.backface_escape},
                        {"query", n.split_query ? "split" : "fused"}, // requested; neural.path says what ran
+                       {"split_min_pairs", n.split_min_pairs},
                        {"roughness_override", n.roughness},
                        {"metallic_override", n.metallic}};
     }

@@ -74,6 +74,13 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
            "(fused); "
            "same image")
         ->check(CLI::IsMember({"split", "fused"}));
+    cmd->add_option(
+           "--neural-split-min-pairs", o.neural.split_min_pairs,
+           "rounds of fewer queued (ray, leaf) pairs than this take the fused query pass instead of the "
+           "split one (its two dispatches cost more than they save on a small round; same image); "
+           "0: every round splits (default " +
+               std::to_string(render::DEFAULT_SPLIT_MIN_PAIRS) + ")")
+        ->check(CLI::Range(0u, 1u << 30));
     cmd->add_option_function<std::string>(
            "--sort-rays", [&o](const std::string& v) { o.sort_rays = v == "on"; },
            "trace secondary and shadow rays grouped by direction and origin (on, default) "

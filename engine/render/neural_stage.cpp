@@ -121,7 +121,7 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
             limits.device_local_bytes ? std::min(limits.buffer_bytes, share) : limits.buffer_bytes;
         const uint64_t pairs = uint64_t(params_.leaves_per_round) * std::max(capacity_, 1u);
         params_.split_chunk = plan_split_query(pairs, bytes, o.split_chunk_limit);
-        split_overflow_ = params_.split_chunk > 0 && params_.split_chunk < pairs;
+        split_fills_ = params_.split_chunk > 0 && params_.split_chunk < pairs;
     }
 }
 
@@ -204,6 +204,7 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     params_.metallic = o.metallic < 0.0f ? -1.0f : o.metallic;
     params_.threshold = o.threshold;
     params_.max_rounds = o.max_rounds;
+    params_.split_min_pairs = o.split_min_pairs;
     params_.occupancy = o.occupancy ? model_.occupancy_offset() : 0u;
     params_.materials = o.materials != NeuralMaterials::asset ? model_.materials_offset() : 0u;
     const bool fits = o.materials == NeuralMaterials::fit || o.materials == NeuralMaterials::mix;

@@ -30,6 +30,8 @@ namespace nbvh::render {
 // NeuralRenderOptions::secondary_lod besides a LoD index.
 inline constexpr int32_t SECONDARY_LOD_SAME = -1;     // the camera rays' LoD
 inline constexpr int32_t SECONDARY_LOD_COARSEST = -2; // the model's coarsest LoD (never finer than lod)
+// NeuralRenderOptions::split_min_pairs by default (H200: results/perf/README.md, split_min_pairs_h200/).
+inline constexpr uint32_t DEFAULT_SPLIT_MIN_PAIRS = 262144;
 
 // What a neural hit's metallic and roughness come from (engine/neural/node_materials.h).
 enum class NeuralMaterials { mix, fit, node, asset };
@@ -84,6 +86,10 @@ struct NeuralRenderOptions {
     // At most this many pairs per chunk of the split query pass (0: as many as one buffer holds); tests
     // use it to take a round in several chunks.
     uint32_t split_chunk_limit = 0;
+    // A round of fewer pairs than this goes to the fused pass whole: where one dispatch of the fused
+    // kernel fills the GPU about once (the last bounces), the split pass's two dispatches cost more than
+    // they save. 0: every round takes the split pass. Same image either way. --neural-split-min-pairs.
+    uint32_t split_min_pairs = DEFAULT_SPLIT_MIN_PAIRS;
 };
 
 // Leaves per round of `options` (throws nbvh::Error when out of range).
@@ -134,11 +140,11 @@ public:
     const NeuralKernelChoice& kernel() const { return kernel_; }
     const char* query_shader() const;
     // The split query pass (NeuralRenderOptions::split_query, where the kernel allows): whether it runs,
-    // whether a round can hold more pairs than its features buffer (the fused pass then takes the rest:
-    // NB_QUERY_MODE_OVERFLOW), and that buffer (bound at NB_BIND_OUTPUT in the split passes' descriptor
-    // sets, lib/bindings.glsl).
+    // whether the fused pass follows it in a round (NB_QUERY_MODE_OVERFLOW: the pairs past its features
+    // buffer where a round can hold more, or a whole round below split_min_pairs), and that buffer (bound at
+    // NB_BIND_OUTPUT in the split passes' descriptor sets, lib/bindings.glsl).
     bool split() const { return params_.split_chunk > 0; }
-    bool split_overflow() const { return split_overflow_; }
+    bool split_overflow() const { return split() && (split_fills_ || params_.split_min_pairs > 0); }
     const vk::Buffer& split_features() const { return split_features_; }
     std::string query_description() const;
     uint32_t rounds() const { return rounds_; }
@@ -163,7 +169,7 @@ private:
     uint32_t rounds_ = 0;
     uint32_t batched_ = 0;
     uint32_t capacity_ = 0;
-    bool split_overflow_ = false;
+    bool split_fills_ = false; // a round can hold more pairs than the features buffer
     vk::Buffer split_features_;
 };
 

@@ -159,7 +159,8 @@ public:
     // a hybrid renderer, through the same neural rounds as camera rays (primary LoD, leaf budget and
     // leaves per round of the options): triangles and neural leaves, closest accepted hit.
     // Query passes per round: 1 (the fused pass), 2 (the split pass's gather and MLP passes) or 3 (and the
-    // fused pass for the pairs past the split pass's features buffer); 0 without a model.
+    // fused pass for the pairs past the split pass's features buffer, or for a whole round below
+    // split_min_pairs); 0 without a model.
     uint32_t neural_query_passes() const;
     std::vector<TraceHit> trace(const std::vector<glm::vec3>& origins, const std::vector<glm::vec3>& dirs, float tmin = 0.0f);
 

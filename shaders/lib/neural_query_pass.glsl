@@ -15,8 +15,8 @@ struct NbPendingQuery {
 };
 
 // First pair of the round a query pass takes: 0, or for the fused pass after the split pass the pairs
-// past its features buffer (NB_QUERY_MODE_OVERFLOW, shared/neural_gpu.h).
-uint nb_query_first_pair() { return (pc.mode & NB_QUERY_MODE_OVERFLOW) != 0u ? neural_params.split_chunk : 0u; }
+// past its features buffer, or all of a small round's (NB_QUERY_MODE_OVERFLOW, shared/neural_gpu.h).
+uint nb_query_first_pair() { return (pc.mode & NB_QUERY_MODE_OVERFLOW) != 0u ? neural_counters.overflow_first : 0u; }
 
 // Pair k of pending half nb_nl_half(pc.mode) (neural_traverse.glsl). Rays >= capacity are shadow
 // rays (shadow SOA index ray - capacity), the others path rays of queue pc.in_queue.

@@ -1,7 +1,8 @@
 // One invocation between a neural traversal round and the neural query pass: hands the pairs queued so
 // far to the query pass (pending_active), empties the queue for the next round, writes the indirect
 // dispatch arguments (NB_NEURAL_GROUP pairs per workgroup; the split query pass: its first
-// neural_params.split_chunk pairs, and the rest for the fused pass) and counts queries for --stats.
+// neural_params.split_chunk pairs, and the rest for the fused pass; a round of fewer than
+// neural_params.split_min_pairs pairs all for the fused pass) and counts queries for --stats.
 #version 460
 #include "lib/bindings.glsl"
 #include "lib/neural_bindings.glsl"
@@ -18,7 +19,8 @@ void main() {
     counters.pending_dispatch.x = (n + NB_NEURAL_GROUP - 1u) / NB_NEURAL_GROUP;
     counters.pending_dispatch.y = 1u;
     counters.pending_dispatch.z = 1u;
-    uint split = min(n, neural_params.split_chunk);
+    uint split = n >= neural_params.split_min_pairs ? min(n, neural_params.split_chunk) : 0u;
+    neural_counters.overflow_first = split;
     neural_counters.split_dispatch.x = (split + NB_NEURAL_GROUP - 1u) / NB_NEURAL_GROUP;
     neural_counters.split_dispatch.y = 1u;
     neural_counters.split_dispatch.z = 1u;

@@ -172,8 +172,15 @@ struct GpuNeuralParams {
     // Pairs of a round the split query pass takes (its features buffer's capacity); the fused pass
     // takes the rest (NB_QUERY_MODE_OVERFLOW). 0: the fused pass takes every pair.
     uint split_chunk;
+    // A round of fewer pairs than this goes to the fused pass whole (passes/neural_args.comp): its
+    // dispatch fills the GPU about once, and the split pass's two dispatches then cost more than they
+    // save (--neural-split-min-pairs). 0: every round starts with the split pass.
+    uint split_min_pairs;
+    uint pad0;
+    uint pad1;
+    uint pad2;
 };
-NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 80, "GpuNeuralParams layout");
+NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 96, "GpuNeuralParams layout");
 
 // A node's metallic and roughness in one word: unorm16 each, metallic in the low half (GLSL
 // unpackUnorm2x16 reads it back as vec2(metallic, roughness)).
@@ -204,7 +211,9 @@ NB_FN vec2 nb_node_fit_spread(vec2 fit, vec2 spread, uint random_bits) {
 // features buffer (nb_split_index: blocks of NB_NEURAL_GROUP pairs, quad-major inside a block), then an MLP
 // pass (passes/neural_query_mlp32.comp) reads them. The buffer holds split_chunk pairs (one binding);
 // a round with more pairs than that (a pending half can hold more) gives the rest to the fused query
-// pass, dispatched after them with NB_QUERY_MODE_OVERFLOW (its pairs start at split_chunk).
+// pass, dispatched after them with NB_QUERY_MODE_OVERFLOW (its pairs start at
+// GpuNeuralCounters::overflow_first: split_chunk, or 0 for a round of fewer than split_min_pairs pairs,
+// which the fused pass takes whole).
 #define NB_SPLIT_FEATURE_QUADS 24u // NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS, 8 bytes each
 #define NB_QUERY_MODE_OVERFLOW 16u // pass-constant mode bit of the fused query pass (bits 0-3: neural_traverse.glsl)
 
@@ -227,7 +236,9 @@ struct GpuNeuralCounters {
     // queries per ray), so that no wave size or --neural-max-leaves can wrap it within a submission (the
     // ray counters grow by at most 2 per path and bounce: wave_plan.h counter_safe_paths).
     uint queries_total_hi;
-    uint pad0;
+    // First pair of the round the fused pass takes after the split pass (NB_QUERY_MODE_OVERFLOW),
+    // written by passes/neural_args.comp: split_chunk, or 0 (a round below split_min_pairs).
+    uint overflow_first;
     uint pad1;
     uint pad2;
     // Statistics: queries per bounce of the path (index = depth, the last bucket also counting deeper
@@ -236,8 +247,8 @@ struct GpuNeuralCounters {
     // wave_plan.h bounds the leaves queued per wave).
     uint queries_by_depth[NB_STAT_DEPTHS];
     // Split query pass (GpuNeuralParams::split_chunk > 0), written by passes/neural_args.comp: the
-    // indirect dispatch of the round's first split_chunk pairs (gather and MLP pass alike), and of the
-    // rest through the fused pass.
+    // indirect dispatch of the round's first split_chunk pairs (gather and MLP pass alike; none for a
+    // round below split_min_pairs), and of the rest through the fused pass.
     GpuDispatchArgs split_dispatch;
     GpuDispatchArgs overflow_dispatch;
 };

@@ -22,6 +22,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 
@@ -98,7 +99,7 @@ TEST(SplitQuery, SameImageAsTheFusedPass) {
 
     const Scene scene = make_scene();
     const SceneAccel accel = build_scene_accel(scene);
-    auto render = [&](bool split, uint32_t limit) {
+    auto render = [&](bool split, uint32_t limit, uint32_t min_pairs) {
         RenderOptions o;
         o.width = 96;
         o.height = 64;
@@ -108,26 +109,35 @@ TEST(SplitQuery, SameImageAsTheFusedPass) {
         o.neural.model = &model;
         o.neural.split_query = split;
         o.neural.split_chunk_limit = limit;
+        o.neural.split_min_pairs = min_pairs;
         WavefrontRenderer r(*ctx, scene, accel, default_sky(), scene.camera, o);
         const RenderResult res = r.render();
         return Frame{res.image.data, res.stats, res.stats.neural_path, r.neural_query_passes()};
     };
-    const Frame fused = render(false, 0);
-    const Frame one = render(true, 0);
+    const Frame fused = render(false, 0, 0);
+    const Frame one = render(true, 0, 0);
     // 96 x 64 x 4 paths, 2 leaves per round: 49,152 pairs per half, 64 of them (one workgroup) in the
     // split pass, the rest of a round's pairs through the fused pass (NB_QUERY_MODE_OVERFLOW).
-    const Frame part = render(true, 64);
+    const Frame part = render(true, 64, 0);
+    // Every round below split_min_pairs: the fused pass takes each whole (its overflow dispatch from pair
+    // 0); then the mean round as the bound: the larger rounds split, the smaller ones fused.
+    const Frame small = render(true, 0, 1u << 30);
+    const uint32_t mean_round =
+        uint32_t(fused.stats.neural_queries / std::max<uint64_t>(fused.stats.neural_rounds, 1));
+    const Frame mixed = render(true, 0, mean_round);
     std::printf("fused: %s, %llu queries; split: %s, %u and %u query passes per round\n", fused.path.c_str(),
                 (unsigned long long)fused.stats.neural_queries, one.path.c_str(), one.query_passes, part.query_passes);
     EXPECT_EQ(fused.query_passes, 1u);
     EXPECT_EQ(one.query_passes, 2u);
     EXPECT_EQ(part.query_passes, 3u);
+    EXPECT_EQ(small.query_passes, 3u);
+    EXPECT_EQ(mixed.query_passes, 3u);
     EXPECT_NE(one.path.find("split"), std::string::npos);
     EXPECT_GT(fused.stats.neural_queries, 1000u);
     // More queries than 64 per round on average: some round held more pairs than the split pass took,
     // so the overflow's fused dispatch had work.
     EXPECT_GT(fused.stats.neural_queries, 64u * fused.stats.neural_rounds);
-    for (const Frame* f : {&one, &part}) {
+    for (const Frame* f : {&one, &part, &small, &mixed}) {
         EXPECT_EQ(f->stats.neural_queries, fused.stats.neural_queries);
         EXPECT_EQ(f->stats.rays_shadow, fused.stats.rays_shadow);
         EXPECT_EQ(f->pixels, fused.pixels);
