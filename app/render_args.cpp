@@ -40,6 +40,12 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
     cmd->add_option("--neural-metallic", o.neural.metallic, "override the metallic of neural surfaces [0,1] (default: each asset's glTF material)");
     cmd->add_option("--neural-max-leaves", o.neural.max_rounds,
                     "neural leaves queried per ray at most (then the closest hit so far is kept)");
+    cmd->add_option(
+           "--neural-max-leaves-secondary", o.neural.max_rounds_secondary,
+           "neural leaves queried per ray at most by rays after the first hit and by shadow rays (a "
+           "truncated ray keeps its closest hit so far; a truncated shadow ray counts as unoccluded); "
+           "0: --neural-max-leaves (default)")
+        ->check(CLI::Range(0u, 256u));
     cmd->add_option("--neural-batched-rounds", o.neural.batched_rounds,
                     "leaf rounds through the batched query pass before the per-ray tail pass");
     cmd->add_option("--neural-leaves-per-round", o.neural.leaves_per_round,

@@ -26,6 +26,7 @@ void validate(const NeuralRenderOptions& o, const Scene& scene) {
     if (!(o.roughness <= 1.0f)) throw Error("--neural-roughness must be in [0, 1]");
     if (!(o.metallic <= 1.0f)) throw Error("--neural-metallic must be in [0, 1]");
     if (o.max_rounds == 0 || o.max_rounds > 256) throw Error("--neural-max-leaves must be in 1..256");
+    if (o.max_rounds_secondary > 256) throw Error("--neural-max-leaves-secondary must be in 0..256");
     if (o.batched_rounds > 256) throw Error("--neural-batched-rounds must be in 0..256");
     if (!(o.threshold > 0.0f && o.threshold < 1.0f)) throw Error("the visibility threshold must be in (0, 1)");
     bool any = false;
@@ -191,8 +192,10 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     params_.leaves_per_round = effective_leaves_per_round(o);
     // Every round queues leaves_per_round leaves per ray still going, or finishes it (fewer leaves left
     // in front of its hit): after ceil(max_rounds / leaves_per_round) rounds no ray is left.
-    const uint32_t needed = (o.max_rounds + params_.leaves_per_round - 1) / params_.leaves_per_round;
-    batched_ = std::min(needed, o.batched_rounds);
+    const uint32_t k = params_.leaves_per_round;
+    const uint32_t secondary_budget = o.max_rounds_secondary ? o.max_rounds_secondary : o.max_rounds;
+    batched_ = std::min((o.max_rounds + k - 1) / k, o.batched_rounds);
+    batched_secondary_ = std::min((secondary_budget + k - 1) / k, o.batched_rounds);
     params_.box = model_.box();
     params_.lod_primary = std::min(o.lod, model_.lod_count() - 1);
     const uint32_t coarsest = model_.lod_count() - 1;
@@ -204,6 +207,7 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     params_.metallic = o.metallic < 0.0f ? -1.0f : o.metallic;
     params_.threshold = o.threshold;
     params_.max_rounds = o.max_rounds;
+    params_.max_rounds_secondary = secondary_budget;
     params_.split_min_pairs = o.split_min_pairs;
     params_.occupancy = o.occupancy ? model_.occupancy_offset() : 0u;
     params_.materials = o.materials != NeuralMaterials::asset ? model_.materials_offset() : 0u;

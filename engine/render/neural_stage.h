@@ -13,6 +13,7 @@
 // The pending queue has two halves: a round's traversal reads its rays from the half just queried and
 // queues into the other (pass constant mode bit 2, shaders/lib/neural_traverse.glsl).
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -50,6 +51,10 @@ struct NeuralRenderOptions {
     // Leaves queried per ray at most (then the closest hit so far is kept). 8: on the default scene at
     // 1080p, 16 -> 8 -> 6 leaves changed FLIP against the classical reference by < 1e-4 (H200 v3/v4).
     uint32_t max_rounds = 8;
+    // The leaf budget of rays after the first hit and of shadow rays (0: max_rounds). A truncated
+    // secondary ray keeps its closest hit so far, a truncated shadow ray counts as unoccluded.
+    // --neural-max-leaves-secondary.
+    uint32_t max_rounds_secondary = 0;
     // Rounds through the batched query pass; rays still going after them finish in neural_tail (one
     // invocation per ray, scalar queries). Default: all rounds batched (the tail measured slower on the
     // H200: its longest ray serialises ~10 scalar queries per pass).
@@ -148,7 +153,10 @@ public:
     const vk::Buffer& split_features() const { return split_features_; }
     std::string query_description() const;
     uint32_t rounds() const { return rounds_; }
-    uint32_t batched_rounds() const { return batched_; }
+    // Batched rounds per bounce of camera rays (secondary = false) or of later and shadow rays; without
+    // an argument the larger (command and timer sizing).
+    uint32_t batched_rounds() const { return std::max(batched_, batched_secondary_); }
+    uint32_t batched_rounds(bool secondary) const { return secondary ? batched_secondary_ : batched_; }
     uint32_t leaves_per_round() const { return params_.leaves_per_round; }
     const GpuNeuralParams& params() const { return params_; }
     const std::vector<GpuNeuralAsset>& assets() const { return assets_; }
@@ -168,6 +176,7 @@ private:
     std::vector<GpuNeuralAsset> assets_;
     uint32_t rounds_ = 0;
     uint32_t batched_ = 0;
+    uint32_t batched_secondary_ = 0;
     uint32_t capacity_ = 0;
     bool split_fills_ = false; // a round can hold more pairs than the features buffer
     vk::Buffer split_features_;

@@ -23,6 +23,8 @@ uint g_nl_last_inst = 0u;
 uint g_nl_last_leaf = 0u;
 // The g_nl_want smallest keys above the last queued one, sorted (g_nl_cand_n of them so far).
 uint g_nl_want = 1u;
+// The ray's leaf budget (nb_nl_budget), set by each pass before its first traversal.
+uint g_nl_budget = 1u;
 uint g_nl_cand_n = 0u;
 float g_nl_cand_t[NB_NL_MAX_LEAVES_PER_ROUND];
 uint g_nl_cand_inst[NB_NL_MAX_LEAVES_PER_ROUND];
@@ -130,9 +132,15 @@ void nb_traverse_neural_instance(uint instance) {
 uint nb_nl_op(uint mode) { return mode & 3u; }
 uint nb_nl_half(uint mode) { return (mode >> 2u) & 1u; }
 
-// Leaves a ray may queue in its next traversal: the round size, within its leaf budget.
+// Leaves a ray may query in all: camera rays neural_params.max_rounds, rays after the first hit and shadow
+// rays max_rounds_secondary (--neural-max-leaves-secondary).
+uint nb_nl_budget(bool camera_ray) {
+    return camera_ray ? neural_params.max_rounds : neural_params.max_rounds_secondary;
+}
+
+// Leaves a ray may queue in its next traversal: the round size, within its leaf budget (g_nl_budget).
 uint nb_nl_want(GpuNeuralRayState st) {
-    uint left = neural_params.max_rounds > st.rounds ? neural_params.max_rounds - st.rounds : 0u;
+    uint left = g_nl_budget > st.rounds ? g_nl_budget - st.rounds : 0u;
     return max(1u, min(min(neural_params.leaves_per_round, NB_NL_MAX_LEAVES_PER_ROUND), left));
 }
 
@@ -146,7 +154,7 @@ bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, vec3 org, 
     uint n = 0u;
     while (n < g_nl_cand_n && g_nl_cand_t[n] < limit) n += 1u;
     if (n == 0u) return false;
-    if (st.rounds >= neural_params.max_rounds) { // a leaf in front of the best hit, no budget left: truncated
+    if (st.rounds >= g_nl_budget) { // a leaf in front of the best hit, no budget left: truncated
         atomicAdd(neural_counters.leaf_cap_rays, 1u);
         return false;
     }

@@ -18,6 +18,7 @@ void main() {
     uint op = nb_nl_op(pc.mode);
     uint half_ = nb_nl_half(pc.mode);
     uint cap = ray_capacity();
+    g_nl_budget = nb_nl_budget(false);
     uint i;
     GpuNeuralRayState st;
     if (op == 1u) {

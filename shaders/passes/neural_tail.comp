@@ -36,6 +36,7 @@ void main() {
     g_alpha_seed = shadow ? nb_shadow_alpha_seed(shadow_load1(NB_SHADOW_PIXEL, i) & ~NB_RAY_BACKFACE_BIT)
                           : ray_load1(pc.in_queue, NB_RAY_RNG, i);
     uint lod = (shadow || pc.depth != 0u) ? neural_params.lod_secondary : neural_params.lod_primary;
+    g_nl_budget = nb_nl_budget(!shadow && pc.depth == 0u);
     GpuNeuralRayState st = nb_state_load(ray);
     bool last = st.status == NB_NRAY_PENDING_LAST; // no leaf left behind this group
     // The group queued by the last batched round, in key order.
@@ -46,7 +47,7 @@ void main() {
         float t = nb_tail_query(rj, n, a);
         nb_nl_take_hit(st, t, n, a, rj.pl.instance, rj.pl.leaf);
     }
-    for (uint guard = 0u; guard <= neural_params.max_rounds; ++guard) {
+    for (uint guard = 0u; guard <= g_nl_budget; ++guard) {
         if (shadow && st.best_t < NB_INF) { // occluded
             st.status = NB_NRAY_DONE;
             nb_state_store(ray, st);
@@ -60,7 +61,7 @@ void main() {
             g_nl_skip_triangles = true;
             nb_trace(org, dir, tmin, limit, shadow);
             found = g_nl_cand_n > 0u && g_nl_cand_t[0] < limit;
-            if (found && st.rounds >= neural_params.max_rounds) { // truncated by the leaf budget
+            if (found && st.rounds >= g_nl_budget) { // truncated by the leaf budget
                 atomicAdd(neural_counters.leaf_cap_rays, 1u);
                 found = false;
             }

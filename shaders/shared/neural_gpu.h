@@ -176,7 +176,9 @@ struct GpuNeuralParams {
     // dispatch fills the GPU about once, and the split pass's two dispatches then cost more than they
     // save (--neural-split-min-pairs). 0: every round starts with the split pass.
     uint split_min_pairs;
-    uint pad0;
+    // Leaves queried per ray at most by rays after the first hit and by shadow rays (camera rays:
+    // max_rounds); <= max_rounds (--neural-max-leaves-secondary).
+    uint max_rounds_secondary;
     uint pad1;
     uint pad2;
 };

@@ -186,6 +186,43 @@ TEST(HybridRender, LeafCapCounterCountsTruncatedRays) {
     EXPECT_LT(cap1.stats.neural_leaf_cap_rays, cap1.stats.rays_total());
 }
 
+// The secondary leaf budget (--neural-max-leaves-secondary) truncates rays after the first hit and shadow
+// rays only: its own value is the default's image; budget 1 for them queries less than the default and
+// more than budget 1 for every ray, truncates fewer rays than the latter, and the tail pass (which
+// keeps the budgets per ray) takes the same decisions as the batched rounds.
+TEST(HybridRender, SecondaryLeafBudgetTruncatesLaterRaysOnly) {
+    NBVH_REQUIRE_SHARED();
+    const Fixture& f = trained_bunny();
+    auto secondary = [](uint32_t batched, uint32_t budget) {
+        return [=](RenderOptions& o) {
+            rounds(batched, 1, 8)(o);
+            o.neural.max_rounds_secondary = budget;
+        };
+    };
+    const Rendered base = render_bunny(f, true, rounds(256, 1, 8));
+    const Rendered same = render_bunny(f, true, secondary(256, 8));
+    const Rendered sec1 = render_bunny(f, true, secondary(256, 1));
+    const Rendered sec1_tail = render_bunny(f, true, secondary(0, 1));
+    const Rendered all1 = render_bunny(f, true, rounds(256, 1, 1));
+    EXPECT_EQ(base.validation + same.validation + sec1.validation + sec1_tail.validation, 0);
+    std::printf("secondary budget: queries %llu (8) / %llu (secondary 1) / %llu (all 1); truncated rays %llu "
+                "/ %llu / %llu\n",
+                (unsigned long long)base.stats.neural_queries, (unsigned long long)sec1.stats.neural_queries,
+                (unsigned long long)all1.stats.neural_queries,
+                (unsigned long long)base.stats.neural_leaf_cap_rays,
+                (unsigned long long)sec1.stats.neural_leaf_cap_rays,
+                (unsigned long long)all1.stats.neural_leaf_cap_rays);
+    EXPECT_EQ(same.image.data, base.image.data);
+    EXPECT_EQ(same.stats.neural_queries, base.stats.neural_queries);
+    EXPECT_LT(sec1.stats.neural_queries, base.stats.neural_queries);
+    EXPECT_GT(sec1.stats.neural_queries, all1.stats.neural_queries);
+    EXPECT_GT(sec1.stats.neural_leaf_cap_rays, base.stats.neural_leaf_cap_rays);
+    EXPECT_LT(sec1.stats.neural_leaf_cap_rays, all1.stats.neural_leaf_cap_rays);
+    EXPECT_EQ(sec1_tail.stats.neural_queries, sec1.stats.neural_queries);
+    EXPECT_EQ(sec1_tail.stats.neural_leaf_cap_rays, sec1.stats.neural_leaf_cap_rays);
+    EXPECT_EQ(sec1.stats.nonfinite_pixels, 0u);
+}
+
 // Several leaves per ray per round (speculative queries of the next leaves in key order) pick the same
 // closest hit as one leaf per round: same image, at least as many queries, fewer rounds. Also with the
 // tail pass after one batched round (it takes a group of several pairs per ray).
@@ -310,6 +347,9 @@ TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
     o.max_rounds = 0;
     EXPECT_THROW(validate(o, f.scene), Error);
     o.max_rounds = 8;
+    o.max_rounds_secondary = 257;
+    EXPECT_THROW(validate(o, f.scene), Error);
+    o.max_rounds_secondary = 0;
     o.leaves_per_round = 0;
     EXPECT_THROW(validate(o, f.scene), Error);
     o.leaves_per_round = NB_NL_MAX_LEAVES_PER_ROUND + 1;
