@@ -72,25 +72,26 @@ nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o
                         {"warmup", a.warmup}};
     if (o.neural.model) {
         const render::NeuralRenderOptions& n = o.neural;
-        j["neural"] = {
-            {"model", a.model},
-            {"lod", n.lod},
-            {"secondary_lod", a.secondary_lod},
-            {"visibility_threshold", n.threshold},
-            {"max_leaves", n.max_rounds},
-            {"max_leaves_secondary", n.max_rounds_secondary ? n.max_rounds_secondary : n.max_rounds},
-            {"leaves_per_round", n.leaves_per_round},
-            {"batched_rounds", n.batched_rounds},
-            {"occupancy", n.occupancy},
-            {"materials", n.materials == render::NeuralMaterials::mix    ? "mix"
-                          : n.materials == render::NeuralMaterials::fit  ? "fit"
-                          : n.materials == render::NeuralMaterials::node ? "node"
-                                                                         : "asset"},
-            {"backface_escape", n.backface_escape},
-            {"query", n.split_query ? "split" : "fused"}, // requested; neural.path says what ran
-            {"split_min_pairs", n.split_min_pairs},
-            {"roughness_override", n.roughness},
-            {"metallic_override", n.metallic}};
+        j["neural"] = {{"model", a.model},
+                       {"lod", n.lod},
+                       {"secondary_lod", a.secondary_lod},
+                       {"visibility_threshold", n.threshold},
+                       {"max_leaves", n.max_rounds},
+                       {"max_leaves_secondary", n.max_rounds_secondary
+                                                    ? std::min(n.max_rounds_secondary, n.max_rounds)
+                                                    : n.max_rounds},
+                       {"leaves_per_round", n.leaves_per_round},
+                       {"batched_rounds", n.batched_rounds},
+                       {"occupancy", n.occupancy},
+                       {"materials", n.materials == render::NeuralMaterials::mix    ? "mix"
+                                     : n.materials == render::NeuralMaterials::fit  ? "fit"
+                                     : n.materials == render::NeuralMaterials::node ? "node"
+                                                                                    : "asset"},
+                       {"backface_escape", n.backface_escape},
+                       {"query", n.split_query ? "split" : "fused"}, // requested; neural.path says what ran
+                       {"split_min_pairs", n.split_min_pairs},
+                       {"roughness_override", n.roughness},
+                       {"metallic_override", n.metallic}};
     }
     j["classical_reference"] = o.neural.classical;
     return j;

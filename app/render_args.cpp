@@ -42,9 +42,9 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
                     "neural leaves queried per ray at most (then the closest hit so far is kept)");
     cmd->add_option(
            "--neural-max-leaves-secondary", o.neural.max_rounds_secondary,
-           "neural leaves queried per ray at most by rays after the first hit and by shadow rays (a "
-           "truncated ray keeps its closest hit so far; a truncated shadow ray counts as unoccluded); "
-           "0: --neural-max-leaves (default)")
+           "neural leaves queried per ray at most by rays after the first hit and by shadow rays, at most "
+           "--neural-max-leaves (a truncated ray keeps its closest hit so far; a truncated shadow ray counts "
+           "as unoccluded); 0: --neural-max-leaves; default 4")
         ->check(CLI::Range(0u, 256u));
     cmd->add_option("--neural-batched-rounds", o.neural.batched_rounds,
                     "leaf rounds through the batched query pass before the per-ray tail pass");

@@ -193,7 +193,8 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     // Every round queues leaves_per_round leaves per ray still going, or finishes it (fewer leaves left
     // in front of its hit): after ceil(max_rounds / leaves_per_round) rounds no ray is left.
     const uint32_t k = params_.leaves_per_round;
-    const uint32_t secondary_budget = o.max_rounds_secondary ? o.max_rounds_secondary : o.max_rounds;
+    const uint32_t secondary_budget =
+        o.max_rounds_secondary ? std::min(o.max_rounds_secondary, o.max_rounds) : o.max_rounds;
     batched_ = std::min((o.max_rounds + k - 1) / k, o.batched_rounds);
     batched_secondary_ = std::min((secondary_budget + k - 1) / k, o.batched_rounds);
     params_.box = model_.box();

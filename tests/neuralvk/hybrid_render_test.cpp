@@ -72,12 +72,13 @@ Rendered render_bunny(const Fixture& f, bool hybrid, const Tweak& tweak = nullpt
     return {convert_channels(res.image, 3), res.stats, ctx.validation_message_count()};
 }
 
-// Batched rounds, leaves per round and the per-ray leaf budget.
+// Batched rounds, leaves per round and the per-ray leaf budget (of every ray: the secondary budget 0).
 Tweak rounds(uint32_t batched, uint32_t leaves_per_round, uint32_t max_leaves = NeuralRenderOptions{}.max_rounds) {
     return [=](RenderOptions& o) {
         o.neural.batched_rounds = batched;
         o.neural.leaves_per_round = leaves_per_round;
         o.neural.max_rounds = max_leaves;
+        o.neural.max_rounds_secondary = 0;
     };
 }
 
@@ -187,9 +188,9 @@ TEST(HybridRender, LeafCapCounterCountsTruncatedRays) {
 }
 
 // The secondary leaf budget (--neural-max-leaves-secondary) truncates rays after the first hit and shadow
-// rays only: its own value is the default's image; budget 1 for them queries less than the default and
-// more than budget 1 for every ray, truncates fewer rays than the latter, and the tail pass (which
-// keeps the budgets per ray) takes the same decisions as the batched rounds.
+// rays only: the camera rays' budget (0) or its value gives the same image; budget 1 for them queries less
+// than the default and more than budget 1 for every ray, truncates fewer rays than the latter, and the tail
+// pass (which keeps the budgets per ray) takes the same decisions as the batched rounds.
 TEST(HybridRender, SecondaryLeafBudgetTruncatesLaterRaysOnly) {
     NBVH_REQUIRE_SHARED();
     const Fixture& f = trained_bunny();
@@ -199,11 +200,12 @@ TEST(HybridRender, SecondaryLeafBudgetTruncatesLaterRaysOnly) {
             o.neural.max_rounds_secondary = budget;
         };
     };
-    const Rendered base = render_bunny(f, true, rounds(256, 1, 8));
+    const Rendered base = render_bunny(f, true, secondary(256, 0));
     const Rendered same = render_bunny(f, true, secondary(256, 8));
     const Rendered sec1 = render_bunny(f, true, secondary(256, 1));
     const Rendered sec1_tail = render_bunny(f, true, secondary(0, 1));
-    const Rendered all1 = render_bunny(f, true, rounds(256, 1, 1));
+    const Rendered all1 = render_bunny(f, true, rounds(256, 1, 1)); // the secondary budget then 1 too
+    const Rendered sec4 = render_bunny(f, true, secondary(256, 4)); // the default secondary budget
     EXPECT_EQ(base.validation + same.validation + sec1.validation + sec1_tail.validation, 0);
     std::printf("secondary budget: queries %llu (8) / %llu (secondary 1) / %llu (all 1); truncated rays %llu "
                 "/ %llu / %llu\n",
@@ -221,6 +223,8 @@ TEST(HybridRender, SecondaryLeafBudgetTruncatesLaterRaysOnly) {
     EXPECT_EQ(sec1_tail.stats.neural_queries, sec1.stats.neural_queries);
     EXPECT_EQ(sec1_tail.stats.neural_leaf_cap_rays, sec1.stats.neural_leaf_cap_rays);
     EXPECT_EQ(sec1.stats.nonfinite_pixels, 0u);
+    EXPECT_LE(sec4.stats.neural_queries, base.stats.neural_queries);
+    EXPECT_GT(sec4.stats.neural_queries, sec1.stats.neural_queries);
 }
 
 // Several leaves per ray per round (speculative queries of the next leaves in key order) pick the same
