@@ -136,8 +136,10 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
     p.lod_secondary = stage.params().lod_secondary;
     p.lod_count = std::max(1u, o.model->lod_count);
     p.leaf_budget = stage.rounds();
+    p.leaf_budget_secondary = stage.params().max_rounds_secondary;
     p.leaves_per_round = stage.leaves_per_round();
-    p.batched_rounds = stage.batched_rounds();
+    p.batched_rounds = stage.batched_rounds(false);
+    p.batched_rounds_secondary = stage.batched_rounds(true);
     p.occupancy = stage.params().occupancy != 0u;
     p.model_has_masks = !o.model->occupancy.empty();
     p.backface_escape = o.backface_escape;
@@ -213,8 +215,11 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
         s += strfmt("  MLP path        %s\n", n->kernel.c_str());
         s += strfmt("  LoD             camera rays %u, after the first hit %u (the model has %u: 0 = finest)\n",
                     n->lod_primary, n->lod_secondary, n->lod_count);
-        s += strfmt("  leaves per ray  at most %u, %u queued per round: %u batched round%s, then neural_tail\n",
-                    n->leaf_budget, n->leaves_per_round, n->batched_rounds, n->batched_rounds == 1 ? "" : "s");
+        s += strfmt("  leaves per ray  at most %u (rays after the first hit and shadow rays %u), %u queued "
+                    "per round: "
+                    "%u batched round%s (the others %u), then neural_tail\n",
+                    n->leaf_budget, n->leaf_budget_secondary, n->leaves_per_round, n->batched_rounds,
+                    n->batched_rounds == 1 ? "" : "s", n->batched_rounds_secondary);
         s += strfmt("  occupancy masks %s\n", n->occupancy          ? "on  (leaves crossing only empty cells are not queried)"
                                               : n->model_has_masks ? "off (--neural-occupancy off)"
                                                                    : "off (the model has no masks: format version < 3 or built without its triangles)");

@@ -65,7 +65,9 @@ struct NeuralPlan {
     std::string query_shader;      // shader of the batched query pass (the fused one)
     bool split_query = false;      // the query pass as neural_gather + neural_query_mlp32 (--neural-query)
     uint32_t lod_primary = 0, lod_secondary = 0, lod_count = 1; // N-BVH cuts (0 = finest) of the model
-    uint32_t leaf_budget = 0;      // leaves queried per ray at most (--neural-max-leaves)
+    uint32_t leaf_budget = 0;              // leaves queried per camera ray at most (--neural-max-leaves)
+    uint32_t leaf_budget_secondary = 0;    // ... per later or shadow ray (--neural-max-leaves-secondary)
+    uint32_t batched_rounds_secondary = 0; // batched rounds of their bounces
     uint32_t leaves_per_round = 0; // leaves a ray queues per round
     uint32_t batched_rounds = 0;   // rounds through the batched query pass before neural_tail
     bool occupancy = false;        // leaves skipped by the model's occupancy masks (on and the model has them)

@@ -30,7 +30,10 @@ TEST(CliExplain, HybridRenderListsTheNeuralPasses) {
     // lavapipe has no cooperative matrices: auto picks the scalar path, as the renderer would.
     EXPECT_TRUE(has(o, "MLP path        scalar")) << o;
     EXPECT_TRUE(has(o, "camera rays 1, after the first hit 0 (the model has 2")) << o;
-    EXPECT_TRUE(has(o, "at most 8, 2 queued per round: 4 batched rounds")) << o; // the defaults
+    // the defaults
+    EXPECT_TRUE(has(o, "at most 8 (rays after the first hit and shadow rays 4), 2 queued per round: 4 "
+                       "batched rounds (the others 2)"))
+        << o;
     EXPECT_TRUE(has(o, "occupancy masks on")) << o;
     EXPECT_TRUE(has(o, "back-face escape on")) << o;
     EXPECT_TRUE(has(o, "materials       per node")) << o;
@@ -71,7 +74,19 @@ TEST(CliExplain, LeavesPerRoundComeFromTheRenderersStage) {
     // --neural-leaves-per-round reaches the renderer's stage (it was a hidden environment variable).
     const auto r = run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round", "3"}), 60.0);
     ASSERT_EQ(r.exit_code, 0) << r.describe();
-    EXPECT_TRUE(has(r.out, "at most 8, 3 queued per round: 3 batched rounds")) << r.out;
+    EXPECT_TRUE(has(r.out, "at most 8 (rays after the first hit and shadow rays 4), 3 queued per round: 3 "
+                           "batched rounds (the others 2)"))
+        << r.out;
+    // The secondary leaf budget, never above the camera rays'.
+    const auto s = run_nbvh(explain({"--model", tiny_model().string(), "--neural-max-leaves", "3",
+                                     "--neural-max-leaves-secondary", "6"}),
+                            60.0);
+    ASSERT_EQ(s.exit_code, 0) << s.describe();
+    EXPECT_TRUE(has(s.out, "at most 3 (rays after the first hit and shadow rays 3)")) << s.out;
+    const auto bad_secondary =
+        run_nbvh(explain({"--model", tiny_model().string(), "--neural-max-leaves-secondary", "300"}), 60.0);
+    EXPECT_EQ(check_clean_error(bad_secondary, {"--neural-max-leaves-secondary"}, false), "")
+        << bad_secondary.describe();
     const auto bad = run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round", "9"}), 60.0);
     EXPECT_EQ(check_clean_error(bad, {"--neural-leaves-per-round"}, false), "") << bad.describe();
 }
