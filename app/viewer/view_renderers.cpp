@@ -51,6 +51,8 @@ render::RenderOptions main_options(const ViewerScene& view, const ViewSettings& 
     o.neural.lod = uint32_t(std::clamp(s.lod, 0, lods - 1));
     o.neural.secondary_lod = std::min(s.secondary_lod, lods - 1);
     o.neural.max_rounds = uint32_t(std::clamp(s.max_leaves, 1, 256));
+    o.neural.max_rounds_secondary =
+        0; // the slider is every ray's budget (nbvh render: 4 after the first hit)
     set_overrides(s, o);
     return o;
 }
