@@ -95,7 +95,11 @@ class StudyRun {
         for (uint32_t l = 0; l < lods; ++l)
             v.push_back({"lod", int(l), int(l), cap, o_.equal_time && l == 0});
         if (lods > 1) v.push_back({"switch", 0, int(lods - 1), cap, o_.equal_time});
-        if (o_.cap_study && o_.cap_study != cap && config == configs_.size() / 2)
+        // The cap row raises every ray's budget (study_config.cpp), so it differs from the others also
+        // where cap_study is the camera rays' budget but later rays have less.
+        const uint32_t secondary = o_.render.neural.max_rounds_secondary;
+        const bool cap_differs = o_.cap_study != cap || (secondary != 0 && secondary < cap);
+        if (o_.cap_study && cap_differs && config == configs_.size() / 2)
             v.push_back({"cap", 0, 0, o_.cap_study, false});
         return v;
     }

@@ -123,6 +123,7 @@ void StudyRun::write_results() const {
           {"time_height", t.height},
           {"repeat", o_.repeat},
           {"max_leaves", o_.render.neural.max_rounds},
+          {"max_leaves_secondary", o_.render.neural.max_rounds_secondary}, // 0: max_leaves; the cap row: 0
           {"cap_study", o_.cap_study},
           {"leaves_per_round", o_.render.neural.leaves_per_round},
           {"neural_path", render::neural_path_name(neural_path_)},

@@ -28,16 +28,27 @@ bool metallic_below_one(const Scene& scene, const Material& m) {
     return false;
 }
 
-std::string neural_rounds_text(const NeuralPlan& n, const char* traverse, const char* what) {
+// `shadow`: the shadow rays' rounds (the secondary leaf budget's count); else the path rays' (the camera
+// rays' count, the secondary one after the first hit).
+std::string neural_rounds_text(const NeuralPlan& n, const char* traverse, const char* what, bool shadow) {
     std::string s;
     s += "    passes/ray_sort.comp       rays in (direction levels, origin cell) order (--sort-rays; not camera rays)\n";
     s += strfmt("    %-26s op 0: %s, queues (ray, leaf) pairs (indirect)\n", traverse, what);
     if (n.batched_rounds > 0) {
-        s += strfmt("    repeat %u x (batched rounds):\n", n.batched_rounds);
+        if (shadow)
+            s += strfmt("    repeat %u x (batched rounds):\n", n.batched_rounds_secondary);
+        else
+            s += strfmt("    repeat %u x (batched rounds; %u after the first hit):\n", n.batched_rounds,
+                        n.batched_rounds_secondary);
         s += "      passes/neural_args.comp    queued pairs -> indirect dispatch arguments\n";
         if (n.split_query) {
             s += "      passes/neural_gather.comp  hash grid of the queued pairs -> features (--neural-query)\n";
             s += "      passes/neural_query_mlp32.comp MLP of those features -> the pairs' hits\n";
+            if (n.split_fused_rest)
+                s +=
+                    strfmt("      %-26s the rest: a round below --neural-split-min-pairs whole, or the pairs "
+                           "past the features buffer\n",
+                           n.query_shader.c_str());
         } else {
             s += strfmt("      %-26s hash grid + MLP of the queued pairs\n", n.query_shader.c_str());
         }
@@ -131,6 +142,7 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
     NeuralPlan p;
     p.kernel = stage.query_description();
     p.split_query = stage.split();
+    p.split_fused_rest = stage.split_overflow();
     p.query_shader = stage.query_shader();
     p.lod_primary = stage.params().lod_primary;
     p.lod_secondary = stage.params().lod_secondary;
@@ -239,7 +251,8 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
     s += strfmt("  repeat %u x:\n", max_depth);
     s += "    passes/queue_args.comp     ray counter -> indirect dispatch arguments\n";
     if (n) {
-        s += neural_rounds_text(*n, "passes/neural_traverse.comp", "closest hit through triangles and N-BVHs");
+        s += neural_rounds_text(*n, "passes/neural_traverse.comp", "closest hit through triangles and N-BVHs",
+                                false);
     } else {
         s += "    passes/ray_sort.comp       bounces > 0: rays in (direction levels, origin cell) order (--sort-rays)\n";
         s += "    passes/traverse.comp       TLAS/BLAS closest hit (indirect)\n";
@@ -247,7 +260,8 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
     s += "    passes/shade.comp          BSDF, emission, light sampling, next ray (indirect)\n";
     if (f.has_lights()) {
         s += "    passes/queue_args.comp     shadow counter -> indirect dispatch arguments\n";
-        if (n) s += neural_rounds_text(*n, "passes/neural_shadow.comp", "visibility through N-BVHs");
+        if (n)
+            s += neural_rounds_text(*n, "passes/neural_shadow.comp", "visibility through N-BVHs", true);
         else s += "    passes/ray_sort.comp       shadow rays in (direction levels, origin cell) order (--sort-rays)\n";
         s += "    passes/shadow.comp         any-hit visibility of light samples (indirect)\n";
     } else {

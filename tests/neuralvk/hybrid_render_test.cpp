@@ -206,7 +206,9 @@ TEST(HybridRender, SecondaryLeafBudgetTruncatesLaterRaysOnly) {
     const Rendered sec1_tail = render_bunny(f, true, secondary(0, 1));
     const Rendered all1 = render_bunny(f, true, rounds(256, 1, 1)); // the secondary budget then 1 too
     const Rendered sec4 = render_bunny(f, true, secondary(256, 4)); // the default secondary budget
-    EXPECT_EQ(base.validation + same.validation + sec1.validation + sec1_tail.validation, 0);
+    EXPECT_EQ(base.validation + same.validation + sec1.validation + sec1_tail.validation + all1.validation +
+                  sec4.validation,
+              0);
     std::printf("secondary budget: queries %llu (8) / %llu (secondary 1) / %llu (all 1); truncated rays %llu "
                 "/ %llu / %llu\n",
                 (unsigned long long)base.stats.neural_queries, (unsigned long long)sec1.stats.neural_queries,
