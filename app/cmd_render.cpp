@@ -77,9 +77,7 @@ nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o
                        {"secondary_lod", a.secondary_lod},
                        {"visibility_threshold", n.threshold},
                        {"max_leaves", n.max_rounds},
-                       {"max_leaves_secondary", n.max_rounds_secondary
-                                                    ? std::min(n.max_rounds_secondary, n.max_rounds)
-                                                    : n.max_rounds},
+                       {"max_leaves_secondary", render::effective_secondary_leaves(n)},
                        {"leaves_per_round", n.leaves_per_round},
                        {"batched_rounds", n.batched_rounds},
                        {"occupancy", n.occupancy},

@@ -21,6 +21,10 @@ uint32_t effective_leaves_per_round(const NeuralRenderOptions& o) {
     return k;
 }
 
+uint32_t effective_secondary_leaves(const NeuralRenderOptions& o) {
+    return o.max_rounds_secondary ? std::min(o.max_rounds_secondary, o.max_rounds) : o.max_rounds;
+}
+
 void validate(const NeuralRenderOptions& o, const Scene& scene) {
     effective_leaves_per_round(o);
     if (!(o.roughness <= 1.0f)) throw Error("--neural-roughness must be in [0, 1]");
@@ -193,8 +197,7 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     // Every round queues leaves_per_round leaves per ray still going, or finishes it (fewer leaves left
     // in front of its hit): after ceil(max_rounds / leaves_per_round) rounds no ray is left.
     const uint32_t k = params_.leaves_per_round;
-    const uint32_t secondary_budget =
-        o.max_rounds_secondary ? std::min(o.max_rounds_secondary, o.max_rounds) : o.max_rounds;
+    const uint32_t secondary_budget = effective_secondary_leaves(o);
     batched_ = std::min((o.max_rounds + k - 1) / k, o.batched_rounds);
     batched_secondary_ = std::min((secondary_budget + k - 1) / k, o.batched_rounds);
     params_.box = model_.box();

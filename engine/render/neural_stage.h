@@ -101,6 +101,9 @@ struct NeuralRenderOptions {
 
 // Leaves per round of `options` (throws nbvh::Error when out of range).
 uint32_t effective_leaves_per_round(const NeuralRenderOptions& options);
+// The leaf budget of rays after the first hit and of shadow rays: max_rounds_secondary, at most
+// max_rounds (0: max_rounds).
+uint32_t effective_secondary_leaves(const NeuralRenderOptions& options);
 
 // Throws nbvh::Error on out-of-range constants (roughness/metallic outside [0,1], rounds 0 or > 256,
 // LoDs beyond the model's, a model with no neural instance in the scene).
