@@ -208,7 +208,7 @@ void run_render(const RenderArgs& a) {
     if (!s.neural_path.empty())
         log_info(
             "render: neural %s: %llu queries (%.2f per ray), %.3g queries/s over %.2f ms of query passes; "
-            "%llu rays truncated by the leaf budget (--neural-max-leaves, --neural-max-leaves-secondary)",
+            "%llu rays spent their leaf budget (--neural-max-leaves, --neural-max-leaves-secondary)",
             s.neural_path.c_str(), (unsigned long long)s.neural_queries, s.neural_queries_per_ray(),
             s.neural_queries_per_second(), s.neural_query_ms, (unsigned long long)s.neural_leaf_cap_rays);
     Exposure exposure{"none", 0.0f};

@@ -149,6 +149,7 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
     p.lod_count = std::max(1u, o.model->lod_count);
     p.leaf_budget = stage.rounds();
     p.leaf_budget_secondary = stage.params().max_rounds_secondary;
+    p.truncated_shadows_block = stage.params().truncated_shadows_block != 0u;
     p.leaves_per_round = stage.leaves_per_round();
     p.batched_rounds = stage.batched_rounds(false);
     p.batched_rounds_secondary = stage.batched_rounds(true);
@@ -232,6 +233,12 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
                     "%u batched round%s (the others %u), then neural_tail\n",
                     n->leaf_budget, n->leaf_budget_secondary, n->leaves_per_round, n->batched_rounds,
                     n->batched_rounds == 1 ? "" : "s", n->batched_rounds_secondary);
+        s += strfmt(
+            "  truncated rays  %s\n",
+            n->truncated_shadows_block
+                ? "a shadow ray is occluded by the leaf its budget leaves out, a path ray keeps its closest "
+                  "hit"
+                : "keep their closest hit, a shadow ray is unoccluded (--neural-truncated-shadows pass)");
         s += strfmt("  occupancy masks %s\n", n->occupancy          ? "on  (leaves crossing only empty cells are not queried)"
                                               : n->model_has_masks ? "off (--neural-occupancy off)"
                                                                    : "off (the model has no masks: format version < 3 or built without its triangles)");

@@ -212,6 +212,7 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     params_.threshold = o.threshold;
     params_.max_rounds = o.max_rounds;
     params_.max_rounds_secondary = secondary_budget;
+    params_.truncated_shadows_block = o.truncated_shadows_block ? 1u : 0u;
     params_.split_min_pairs = o.split_min_pairs;
     params_.occupancy = o.occupancy ? model_.occupancy_offset() : 0u;
     params_.materials = o.materials != NeuralMaterials::asset ? model_.materials_offset() : 0u;

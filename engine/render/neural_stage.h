@@ -57,6 +57,10 @@ struct NeuralRenderOptions {
     // on the default scene, the dragon and Chess for FLIP +0.0003 / +0.0001 / +0.0001 against the
     // converged reference; 2 and 1 cost far more error. --neural-max-leaves-secondary.
     uint32_t max_rounds_secondary = 4;
+    // A shadow ray truncated by its leaf budget (a leaf with occupied cells left in front of its end):
+    // true, occluded; false, unoccluded. The round that spends a shadow ray's budget then looks for one
+    // leaf more than it queues (no re-traversal). --neural-truncated-shadows block|pass.
+    bool truncated_shadows_block = false;
     // Rounds through the batched query pass; rays still going after them finish in neural_tail (one
     // invocation per ray, scalar queries). Default: all rounds batched (the tail measured slower on the
     // H200: its longest ray serialises ~10 scalar queries per pass).

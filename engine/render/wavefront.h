@@ -86,7 +86,7 @@ struct RenderStats {
     std::string neural_path;
     uint64_t neural_queries = 0, neural_rounds = 0;
     std::vector<uint64_t> neural_queries_by_depth; // per bounce, as rays_by_depth (their sum: neural_queries)
-    uint64_t neural_leaf_cap_rays = 0; // rays truncated by the leaf budget (--neural-max-leaves)
+    uint64_t neural_leaf_cap_rays = 0;             // rays that spent their leaf budget (it may have cut them)
     double neural_query_ms = 0.0;
     double neural_queries_per_ray() const {
         const uint64_t r = rays_primary + rays_secondary;

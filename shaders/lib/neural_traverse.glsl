@@ -25,6 +25,11 @@ uint g_nl_last_leaf = 0u;
 uint g_nl_want = 1u;
 // The ray's leaf budget (nb_nl_budget), set by each pass before its first traversal.
 uint g_nl_budget = 1u;
+// Set when the ray was found truncated by its leaf budget (a leaf left in front of its best hit).
+bool g_nl_truncated = false;
+// Shadow rays under --neural-truncated-shadows block: a round that spends the budget looks for one
+// leaf more (nb_nl_want), whose key decides whether the ray is truncated.
+bool g_nl_probe = false;
 uint g_nl_cand_n = 0u;
 float g_nl_cand_t[NB_NL_MAX_LEAVES_PER_ROUND];
 uint g_nl_cand_inst[NB_NL_MAX_LEAVES_PER_ROUND];
@@ -138,10 +143,14 @@ uint nb_nl_budget(bool camera_ray) {
     return camera_ray ? neural_params.max_rounds : neural_params.max_rounds_secondary;
 }
 
-// Leaves a ray may queue in its next traversal: the round size, within its leaf budget (g_nl_budget).
+// Leaves a ray's next traversal looks for: the round size, within its leaf budget (g_nl_budget). Under
+// g_nl_probe a round that spends the budget looks for one leaf more (where the candidate list has
+// room), never queued: whether it lies in front of the ray's end after the round's hits tells whether
+// the budget truncated the ray (NB_NRAY_PENDING_CAP), without the re-traversal that would find it.
 uint nb_nl_want(GpuNeuralRayState st) {
     uint left = g_nl_budget > st.rounds ? g_nl_budget - st.rounds : 0u;
-    return max(1u, min(min(neural_params.leaves_per_round, NB_NL_MAX_LEAVES_PER_ROUND), left));
+    uint k = max(1u, min(min(neural_params.leaves_per_round, NB_NL_MAX_LEAVES_PER_ROUND), left));
+    return g_nl_probe && k == left && k < NB_NL_MAX_LEAVES_PER_ROUND ? k + 1u : k;
 }
 
 // Queues the candidates of the last traversal in front of `limit` (within the ray's leaf budget),
@@ -151,13 +160,15 @@ uint nb_nl_want(GpuNeuralRayState st) {
 // queue: NB_RAY_BACKFACE_BIT of a path ray's NB_RAY_DEPTH word, of a shadow ray's NB_SHADOW_PIXEL word).
 bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, vec3 org, vec3 dir, float t_bound,
                            inout GpuNeuralRayState st) {
-    uint n = 0u;
-    while (n < g_nl_cand_n && g_nl_cand_t[n] < limit) n += 1u;
-    if (n == 0u) return false;
+    uint found = 0u;
+    while (found < g_nl_cand_n && g_nl_cand_t[found] < limit) found += 1u;
+    if (found == 0u) return false;
     if (st.rounds >= g_nl_budget) { // a leaf in front of the best hit, no budget left: truncated
-        atomicAdd(neural_counters.leaf_cap_rays, 1u);
+        g_nl_truncated = true;      // (counted in leaf_cap_rays when the budget was spent)
         return false;
     }
+    uint left = g_nl_budget - st.rounds;
+    uint n = min(found, left); // a leaf found beyond the budget (g_nl_probe) is not queued
     uint cap = ray_capacity();
     uint flag = (state_index >= cap ? shadow_load1(NB_SHADOW_PIXEL, state_index - cap)
                                     : ray_load1(pc.in_queue, NB_RAY_DEPTH, state_index)) & NB_RAY_BACKFACE_BIT;
@@ -178,12 +189,22 @@ bool nb_nl_queue_candidate(uint state_index, uint half_, float limit, vec3 org, 
     st.key_t = g_nl_cand_t[n - 1u];
     st.key_instance = g_nl_cand_inst[n - 1u];
     st.key_leaf = g_nl_cand_leaf[n - 1u];
-    // Fewer than g_nl_want queued: the candidate list was not full (no leaf in front of the limit was
+    // Fewer than g_nl_want found: the candidate list was not full (no leaf in front of the limit was
     // left out) or a candidate lay behind the limit (so do all later ones). Either way no leaf remains.
-    // A ray whose budget this group spends is resumed once more (not finished here), so that a leaf left
-    // in front of its best hit is seen and counted (leaf_cap_rays) rather than silently dropped.
-    bool last = n < g_nl_want;
+    bool last = found < g_nl_want;
     st.status = last ? NB_NRAY_PENDING_LAST : NB_NRAY_PENDING;
+    if (n == left) { // the group spends the ray's budget: counted in leaf_cap_rays (the budget may cut it)
+        atomicAdd(neural_counters.leaf_cap_rays, 1u);
+        if (found > n) { // g_nl_probe: a leaf found beyond the budget, its key decides after the hits
+            st.status = NB_NRAY_PENDING_CAP;
+            st.key_t = g_nl_cand_t[n];
+        } else if (!g_nl_probe) {
+            // Nothing to decide: the resumed round finishes the ray (a leaf left in front of its best
+            // hit is passed). Under g_nl_probe with no room to look further (a round of
+            // NB_NL_MAX_LEAVES_PER_ROUND leaves) the ray is resumed once more to find one.
+            st.status = NB_NRAY_PENDING_LAST;
+        }
+    }
     st.rounds += n;
     return true;
 }
@@ -207,7 +228,9 @@ void nb_nl_take_hit(inout GpuNeuralRayState st, float t, vec3 normal, vec3 albed
 // re-traversal would find nothing: the ray is finished without it (same decisions, same image).
 bool nb_nl_may_have_more(GpuNeuralRayState st, float limit) { return st.key_t < limit; }
 
-bool nb_nl_is_pending(uint status) { return status == NB_NRAY_PENDING || status == NB_NRAY_PENDING_LAST; }
+bool nb_nl_is_pending(uint status) {
+    return status == NB_NRAY_PENDING || status == NB_NRAY_PENDING_LAST || status == NB_NRAY_PENDING_CAP;
+}
 
 // The resumed traversal of a ray: the results of its `group` pairs from pending slot `slot` on.
 void nb_nl_reduce_group(uint slot, uint group, inout GpuNeuralRayState st) {
@@ -236,6 +259,10 @@ void nb_nl_finish_path(uint i, inout GpuNeuralRayState st) {
         hit_store1(NB_HIT_TRIANGLE, i, NB_NEURAL_TRIANGLE);
     }
 }
+
+// A shadow ray truncated by its leaf budget is occluded under --neural-truncated-shadows block (the
+// leaf left in front of it holds occupied cells along the ray: a candidate passed the occupancy walk).
+bool nb_nl_shadow_blocked() { return g_nl_truncated && g_nl_probe; }
 
 GpuNeuralRayState nb_nl_fresh_state() {
     GpuNeuralRayState st;

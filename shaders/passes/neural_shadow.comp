@@ -5,8 +5,8 @@
 // reads anyway: a ray found unoccluded stores nothing.
 //   op 0: every shadow ray: triangle any-hit (occluded -> done), else queue the first neural leaf;
 //   op 1: the rays of the pairs just queried (first pair of each ray's group): any accepted hit of the
-//         group -> occluded, done; the group was the ray's last -> not occluded, done; else queue the
-//         next leaves.
+//         group -> occluded, done; the group was the ray's last or spent its budget -> not occluded,
+//         done; else queue the next leaves.
 // shadow.comp then reads the result instead of tracing.
 #version 460
 #include "lib/bindings.glsl"
@@ -19,6 +19,7 @@ void main() {
     uint half_ = nb_nl_half(pc.mode);
     uint cap = ray_capacity();
     g_nl_budget = nb_nl_budget(false);
+    g_nl_probe = neural_params.truncated_shadows_block != 0u;
     uint i;
     GpuNeuralRayState st;
     if (op == 1u) {
@@ -31,11 +32,15 @@ void main() {
         st = nb_state_load(cap + i);
         if (!nb_nl_is_pending(st.status)) return;
         bool last = st.status == NB_NRAY_PENDING_LAST;
+        bool capped = st.status == NB_NRAY_PENDING_CAP;
         nb_nl_reduce_group(slot, nb_pair_group(pl.group), st);
-        // An occluder found, or no leaf left (also when the last key lies at or beyond the shadow ray's
-        // end): done without re-traversal.
-        if (last || st.best_t < NB_INF ||
-            !nb_nl_may_have_more(st, uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, pl.ray - cap)))) {
+        float tmax = uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, pl.ray - cap));
+        // No occluder among the group's hits and the leaf found beyond the budget in front of the
+        // ray's end: truncated, occluded by that leaf (below).
+        if (capped && st.best_t == NB_INF && nb_nl_may_have_more(st, tmax)) st.best_t = 0.0f;
+        // An occluder found, no leaf left (also when the last key lies at or beyond the shadow ray's
+        // end) or the budget spent: done without re-traversal.
+        if (last || capped || st.best_t < NB_INF || !nb_nl_may_have_more(st, tmax)) {
             st.status = NB_NRAY_DONE;
             nb_state_store(cap + i, st);
             if (st.best_t < NB_INF) nb_shadow_mark_occluded(i);
@@ -70,6 +75,7 @@ void main() {
     if (!nb_nl_queue_candidate(cap + i, half_, tmax, org, dir, tmax, st)) {
         // No leaf in front of tmax: not occluded. A ray decided by its first traversal stores nothing
         // (op 1 and the tail read only the states of rays with queued pairs).
+        if (nb_nl_shadow_blocked()) nb_shadow_mark_occluded(i);
         if (op == 0u) return;
         st.status = NB_NRAY_DONE;
     }

@@ -2,8 +2,9 @@
 // have leaves to visit, and each further round would cost three dependent dispatches for them. This
 // pass takes the pairs queued by the last batched round (pending half nb_nl_half(pc.mode)) and finishes
 // each ray in one invocation (the first pair of its group): the group's queries (scalar network), then
-// re-traverse the neural instances for the next leaf, query, ... until no leaf is left in front of its best hit or its leaf budget is spent. Same
-// decisions as the batched rounds (same ordering keys, same decode), without the round trips.
+// re-traverse the neural instances for the next leaf, query, ... until no leaf is left in front of its
+// best hit or its leaf budget is spent. Same decisions as the batched rounds (same ordering keys, same
+// decode), without the round trips.
 #version 460
 #include "lib/bindings.glsl"
 #include "lib/traverse.glsl"
@@ -37,8 +38,11 @@ void main() {
                           : ray_load1(pc.in_queue, NB_RAY_RNG, i);
     uint lod = (shadow || pc.depth != 0u) ? neural_params.lod_secondary : neural_params.lod_primary;
     g_nl_budget = nb_nl_budget(!shadow && pc.depth == 0u);
+    g_nl_probe = shadow && neural_params.truncated_shadows_block != 0u;
     GpuNeuralRayState st = nb_state_load(ray);
     bool last = st.status == NB_NRAY_PENDING_LAST; // no leaf left behind this group
+    bool capped = st.status == NB_NRAY_PENDING_CAP; // the budget spent, the leaf beyond it at key_t
+    // (a ray whose last batched group spent its budget was counted in leaf_cap_rays there)
     // The group queued by the last batched round, in key order.
     uint group = nb_pair_group(r.pl.group);
     for (uint j = 0u; j < group; ++j) {
@@ -56,19 +60,25 @@ void main() {
         }
         float limit = shadow ? tmax : min(st.tri_t, st.best_t);
         bool found = false;
-        if (!last && nb_nl_may_have_more(st, limit)) { // (only the first iteration can see last == true)
+        if (capped) { // (only the first iteration) truncated when the leaf beyond lies in front
+            g_nl_truncated = nb_nl_may_have_more(st, limit);
+        } else if (!last && nb_nl_may_have_more(st, limit)) {
             nb_nl_begin(st, lod, 1u);
             g_nl_skip_triangles = true;
             nb_trace(org, dir, tmin, limit, shadow);
             found = g_nl_cand_n > 0u && g_nl_cand_t[0] < limit;
-            if (found && st.rounds >= g_nl_budget) { // truncated by the leaf budget
-                atomicAdd(neural_counters.leaf_cap_rays, 1u);
+            if (found && st.rounds >= g_nl_budget) { // truncated by the leaf budget (counted when spent)
+                g_nl_truncated = true;
                 found = false;
             }
         }
         if (!found) {
-            if (shadow) st.status = NB_NRAY_DONE;
-            else nb_nl_finish_path(i, st);
+            if (shadow) {
+                st.status = NB_NRAY_DONE;
+                if (nb_nl_shadow_blocked()) nb_shadow_mark_occluded(i);
+            } else {
+                nb_nl_finish_path(i, st);
+            }
             nb_state_store(ray, st);
             return;
         }
@@ -89,6 +99,10 @@ void main() {
         vec3 n, a;
         float t = nb_tail_query(r, n, a);
         nb_nl_take_hit(st, t, n, a, r.pl.instance, r.pl.leaf);
+        if (st.rounds == g_nl_budget) { // the budget spent (as in nb_nl_queue_candidate)
+            atomicAdd(neural_counters.leaf_cap_rays, 1u);
+            last = !g_nl_probe; // else one more traversal tells whether a leaf is left (truncated)
+        }
     }
     // Not reached: each turn above spends one leaf of the budget, and the turn after the last one
     // returns. Finished here all the same, so that no ray leaves the tail undecided.

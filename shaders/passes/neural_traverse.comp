@@ -35,7 +35,8 @@ void main() {
         if (!nb_nl_is_pending(st.status)) return;
         bool last = st.status == NB_NRAY_PENDING_LAST;
         nb_nl_reduce_group(slot, nb_pair_group(pl.group), st);
-        if (last || !nb_nl_may_have_more(st, min(st.tri_t, st.best_t))) { // nothing left in front: no re-traversal
+        // Nothing left in front, or the budget spent: no re-traversal.
+        if (last || !nb_nl_may_have_more(st, min(st.tri_t, st.best_t))) {
             nb_nl_finish_path(i, st);
             nb_state_store(i, st);
             return;

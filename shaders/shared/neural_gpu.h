@@ -109,9 +109,15 @@ NB_FN void nb_neural_cull_bounds(NB_INOUT(vec3) lo, NB_INOUT(vec3) hi) {
 #define NB_NRAY_PENDING 1u  // a (ray, leaf) pair is queued
 #define NB_NRAY_DONE 2u
 // A group is queued and is the ray's last: its traversal found fewer leaves than it looked for in
-// front of the best hit (every leaf left in front was queued; hits only move the limit closer), or
-// the leaf budget is spent. The resumed round then finishes the ray without re-traversing.
+// front of the best hit (every leaf left in front was queued; hits only move the limit closer), or it
+// spends the leaf budget (a leaf left is passed). The resumed round then finishes the ray without
+// re-traversing.
 #define NB_NRAY_PENDING_LAST 3u
+// A shadow ray's group is queued that spends its leaf budget under --neural-truncated-shadows block,
+// and its traversal found one leaf more in front of the ray's end (looked for, never queued): its key's
+// distance replaces key_t. The resumed round finishes the ray without re-traversing: occluded by that
+// leaf when no hit of the group occludes it and the leaf lies in front of the ray's end.
+#define NB_NRAY_PENDING_CAP 4u
 struct GpuNeuralRayState {
     vec3 normal;    // world-space unit normal of the best neural hit
     float best_t;   // NB_INF: none
@@ -179,7 +185,8 @@ struct GpuNeuralParams {
     // Leaves queried per ray at most by rays after the first hit and by shadow rays (camera rays:
     // max_rounds); <= max_rounds (--neural-max-leaves-secondary).
     uint max_rounds_secondary;
-    uint pad1;
+    // 1: a shadow ray truncated by its leaf budget is occluded (--neural-truncated-shadows block).
+    uint truncated_shadows_block;
     uint pad2;
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 96, "GpuNeuralParams layout");
@@ -231,7 +238,7 @@ NB_FN uint nb_split_index(uint k, uint s) {
 struct GpuNeuralCounters {
     uint pending_active;  // pairs the current neural_query dispatch processes
     uint queries_total;   // statistics: queries of the render (path and shadow rays), low 32 bits
-    uint leaf_cap_rays;   // statistics: rays (path and shadow) left with a leaf in front of their best hit
+    uint leaf_cap_rays;   // statistics: rays (path and shadow) that spent their leaf budget
                           // when their leaf budget (max_rounds) was spent: truncated by the cap
     uint rounds;          // statistics: rounds with at least one pair
     // High 32 bits of queries_total: the one statistic that grows with the leaf budget (up to max_rounds

@@ -87,6 +87,20 @@ TEST(CliExplain, LeavesPerRoundComeFromTheRenderersStage) {
         run_nbvh(explain({"--model", tiny_model().string(), "--neural-max-leaves-secondary", "300"}), 60.0);
     EXPECT_EQ(check_clean_error(bad_secondary, {"--neural-max-leaves-secondary"}, false), "")
         << bad_secondary.describe();
+    // What a truncated shadow ray does, either way and a bad value.
+    const auto block =
+        run_nbvh(explain({"--model", tiny_model().string(), "--neural-truncated-shadows", "block"}), 60.0);
+    ASSERT_EQ(block.exit_code, 0) << block.describe();
+    EXPECT_TRUE(has(block.out, "truncated rays  a shadow ray is occluded")) << block.out;
+    const auto pass =
+        run_nbvh(explain({"--model", tiny_model().string(), "--neural-truncated-shadows", "pass"}), 60.0);
+    ASSERT_EQ(pass.exit_code, 0) << pass.describe();
+    EXPECT_TRUE(has(pass.out, "truncated rays  keep their closest hit, a shadow ray is unoccluded"))
+        << pass.out;
+    const auto bad_shadows =
+        run_nbvh(explain({"--model", tiny_model().string(), "--neural-truncated-shadows", "maybe"}), 60.0);
+    EXPECT_EQ(check_clean_error(bad_shadows, {"--neural-truncated-shadows"}, false), "")
+        << bad_shadows.describe();
     const auto bad = run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round", "9"}), 60.0);
     EXPECT_EQ(check_clean_error(bad, {"--neural-leaves-per-round"}, false), "") << bad.describe();
 }

@@ -165,11 +165,10 @@ TEST(HybridRender, TailPassMatchesBatchedRounds) {
     EXPECT_GT(all_batched.stats.neural_queries_by_depth.at(1), 0u);
 }
 
-// The leaf-cap counter (RenderStats::neural_leaf_cap_rays) counts rays truncated by their leaf budget:
-// with one leaf per ray the bunny's grazing and silhouette rays (several leaves along them) are cut;
-// the same rays are counted whether the batched rounds or the tail pass find the leaf left over; with a
-// budget no ray reaches, none is counted and the image is that of the default budget or better.
-TEST(HybridRender, LeafCapCounterCountsTruncatedRays) {
+// The leaf-cap counter (RenderStats::neural_leaf_cap_rays) counts rays that spend their leaf budget (the
+// budget may cut them): with one leaf per ray every ray that queries a leaf; the same rays whether the
+// batched rounds or the tail pass query it; with a budget no ray reaches, none.
+TEST(HybridRender, LeafCapCounterCountsRaysAtTheirBudget) {
     NBVH_REQUIRE_SHARED();
     const Fixture& f = trained_bunny();
     const Rendered cap1 = render_bunny(f, true, rounds(256, 1, 1));
@@ -185,6 +184,56 @@ TEST(HybridRender, LeafCapCounterCountsTruncatedRays) {
     EXPECT_EQ(cap1.stats.neural_queries, cap1_tail.stats.neural_queries);
     EXPECT_EQ(cap256.stats.neural_leaf_cap_rays, 0u);
     EXPECT_LT(cap1.stats.neural_leaf_cap_rays, cap1.stats.rays_total());
+}
+
+// Truncated shadow rays (--neural-truncated-shadows): blocking them only takes light away (no pixel
+// brighter, the mean darker) and changes no path (same queries, same rays counted at their budget). The
+// decision needs the leaf beyond the budget: found by the round that spends it (one leaf more looked
+// for), by the resumed traversal where a round of 4 leaves leaves no room, or by the tail pass: the same
+// decisions, so the same image.
+TEST(HybridRender, TruncatedShadowsPassOrBlock) {
+    NBVH_REQUIRE_SHARED();
+    const Fixture& f = trained_bunny();
+    auto truncate = [](uint32_t batched, uint32_t per_round, uint32_t secondary, bool block) {
+        return [=](RenderOptions& o) {
+            rounds(batched, per_round, 8)(o);
+            o.neural.max_rounds_secondary = secondary;
+            o.neural.truncated_shadows_block = block;
+        };
+    };
+    const Rendered pass = render_bunny(f, true, truncate(256, 1, 1, false));
+    const Rendered block = render_bunny(f, true, truncate(256, 1, 1, true));
+    const Rendered block_tail = render_bunny(f, true, truncate(0, 1, 1, true));
+    const Rendered block2 = render_bunny(f, true, truncate(256, 2, 4, true)); // looks one leaf further
+    const Rendered block4 = render_bunny(f, true, truncate(256, 4, 4, true)); // resumed once more
+    EXPECT_EQ(pass.validation + block.validation + block_tail.validation + block2.validation +
+                  block4.validation,
+              0);
+    auto mean = [](const Image& im) {
+        double m = 0.0;
+        for (float v : im.data) m += v;
+        return m / double(im.data.size());
+    };
+    const float f_tail = flip_hdr(block.image, block_tail.image).mean;
+    const float f_room = flip_hdr(block2.image, block4.image).mean;
+    std::printf(
+        "truncated shadow rays: image mean pass %.5f, block %.5f; rays at their budget %llu / %llu; FLIP "
+        "block vs its tail %.2e, 2 vs 4 leaves per round %.2e\n",
+        mean(pass.image), mean(block.image), (unsigned long long)pass.stats.neural_leaf_cap_rays,
+        (unsigned long long)block.stats.neural_leaf_cap_rays, f_tail, f_room);
+    ASSERT_EQ(block.image.data.size(), pass.image.data.size());
+    size_t brighter = 0;
+    for (size_t k = 0; k < pass.image.data.size(); ++k)
+        brighter += block.image.data[k] > pass.image.data[k] * (1.0f + 1e-5f) + 1e-6f ? 1u : 0u;
+    EXPECT_EQ(brighter, 0u);
+    EXPECT_LT(mean(block.image), mean(pass.image));
+    EXPECT_EQ(block.stats.neural_queries, pass.stats.neural_queries);
+    EXPECT_EQ(block.stats.neural_leaf_cap_rays, pass.stats.neural_leaf_cap_rays);
+    EXPECT_GT(block.stats.neural_leaf_cap_rays, 0u);
+    EXPECT_EQ(block.stats.nonfinite_pixels, 0u);
+    EXPECT_EQ(block_tail.stats.neural_leaf_cap_rays, block.stats.neural_leaf_cap_rays);
+    EXPECT_LT(f_tail, 1e-3f);
+    EXPECT_LT(f_room, 1e-3f);
 }
 
 // The secondary leaf budget (--neural-max-leaves-secondary) truncates rays after the first hit and shadow
