@@ -52,15 +52,19 @@ struct NeuralRenderOptions {
     // 1080p, 16 -> 8 -> 6 leaves changed FLIP against the classical reference by < 1e-4 (H200 v3/v4).
     uint32_t max_rounds = 8;
     // The leaf budget of rays after the first hit and of shadow rays, at most max_rounds (0: max_rounds).
-    // A truncated secondary ray keeps its closest hit so far, a truncated shadow ray counts as
-    // unoccluded. 4 (H200, 1080p 16 spp, results/perf/secondary_leaves_h200/): frames -2.8 / -5.5 / -1.4 %
-    // on the default scene, the dragon and Chess for FLIP +0.0003 / +0.0001 / +0.0001 against the
-    // converged reference; 2 and 1 cost far more error. --neural-max-leaves-secondary.
-    uint32_t max_rounds_secondary = 4;
+    // A truncated secondary ray keeps its closest hit so far (a truncated shadow ray:
+    // truncated_shadows_block). 2, with truncated shadow rays blocked (H200, 1080p 16 spp, one call,
+    // results/perf/secondary_budget2_h200/): against 4 with shadows passing (the default before), the
+    // default scene 1.48x -> 1.29x classical for FLIP 0.0133 -> 0.0185 against the converged reference,
+    // the dragon 1.81x -> 1.39x for 0.0031 -> 0.0097, Chess 1.37x -> 1.25x for 0.0305 -> 0.0338.
+    // --neural-max-leaves-secondary.
+    uint32_t max_rounds_secondary = 2;
     // A shadow ray truncated by its leaf budget (a leaf with occupied cells left in front of its end):
     // true, occluded; false, unoccluded. The round that spends a shadow ray's budget then looks for one
-    // leaf more than it queues (no re-traversal). --neural-truncated-shadows block|pass.
-    bool truncated_shadows_block = false;
+    // leaf more than it queues (no re-traversal). At budget 2 (same call): FLIP 0.0204 -> 0.0185 on the
+    // default scene, 0.0384 -> 0.0338 on Chess, 0.0061 -> 0.0097 on the dragon, for +1 % frame time.
+    // --neural-truncated-shadows block|pass.
+    bool truncated_shadows_block = true;
     // Rounds through the batched query pass; rays still going after them finish in neural_tail (one
     // invocation per ray, scalar queries). Default: all rounds batched (the tail measured slower on the
     // H200: its longest ray serialises ~10 scalar queries per pass).

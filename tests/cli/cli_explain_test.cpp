@@ -31,9 +31,10 @@ TEST(CliExplain, HybridRenderListsTheNeuralPasses) {
     EXPECT_TRUE(has(o, "MLP path        scalar")) << o;
     EXPECT_TRUE(has(o, "camera rays 1, after the first hit 0 (the model has 2")) << o;
     // the defaults
-    EXPECT_TRUE(has(o, "at most 8 (rays after the first hit and shadow rays 4), 2 queued per round: 4 "
-                       "batched rounds (the others 2)"))
+    EXPECT_TRUE(has(o, "at most 8 (rays after the first hit and shadow rays 2), 2 queued per round: 4 "
+                       "batched rounds (the others 1)"))
         << o;
+    EXPECT_TRUE(has(o, "truncated rays  a shadow ray is occluded")) << o;
     EXPECT_TRUE(has(o, "occupancy masks on")) << o;
     EXPECT_TRUE(has(o, "back-face escape on")) << o;
     EXPECT_TRUE(has(o, "materials       per node")) << o;
@@ -74,8 +75,8 @@ TEST(CliExplain, LeavesPerRoundComeFromTheRenderersStage) {
     // --neural-leaves-per-round reaches the renderer's stage (it was a hidden environment variable).
     const auto r = run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round", "3"}), 60.0);
     ASSERT_EQ(r.exit_code, 0) << r.describe();
-    EXPECT_TRUE(has(r.out, "at most 8 (rays after the first hit and shadow rays 4), 3 queued per round: 3 "
-                           "batched rounds (the others 2)"))
+    EXPECT_TRUE(has(r.out, "at most 8 (rays after the first hit and shadow rays 2), 3 queued per round: 3 "
+                           "batched rounds (the others 1)"))
         << r.out;
     // The secondary leaf budget, never above the camera rays'.
     const auto s = run_nbvh(explain({"--model", tiny_model().string(), "--neural-max-leaves", "3",

@@ -254,7 +254,7 @@ TEST(HybridRender, SecondaryLeafBudgetTruncatesLaterRaysOnly) {
     const Rendered sec1 = render_bunny(f, true, secondary(256, 1));
     const Rendered sec1_tail = render_bunny(f, true, secondary(0, 1));
     const Rendered all1 = render_bunny(f, true, rounds(256, 1, 1)); // the secondary budget then 1 too
-    const Rendered sec4 = render_bunny(f, true, secondary(256, 4)); // the default secondary budget
+    const Rendered sec4 = render_bunny(f, true, secondary(256, 4)); // the default secondary budget before 2
     EXPECT_EQ(base.validation + same.validation + sec1.validation + sec1_tail.validation + all1.validation +
                   sec4.validation,
               0);
