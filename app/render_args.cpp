@@ -43,14 +43,17 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
     cmd->add_option(
            "--neural-max-leaves-secondary", o.neural.max_rounds_secondary,
            "neural leaves queried per ray at most by rays after the first hit and by shadow rays, at most "
-           "--neural-max-leaves (a truncated ray keeps its closest hit so far; a truncated shadow ray counts "
-           "as unoccluded, or occluded: --neural-truncated-shadows); 0: --neural-max-leaves; default 2")
+           "--neural-max-leaves (a truncated ray keeps its closest hit so far; a truncated shadow ray: "
+           "--neural-truncated-shadows); 0: --neural-max-leaves; default 2")
         ->check(CLI::Range(0u, 256u));
     cmd->add_option_function<std::string>(
            "--neural-truncated-shadows",
            [&o](const std::string& v) { o.neural.truncated_shadows_block = v == "block"; },
-           "a shadow ray truncated by its leaf budget (a leaf with occupied cells left in front of its end): "
-           "occluded (block, default) or unoccluded (pass)")
+           "a shadow ray truncated by its leaf budget (a leaf left in front of its end; with occupancy "
+           "masks, "
+           "one whose cells along the ray are occupied): occluded by that leaf (block, default) or "
+           "unoccluded "
+           "(pass)")
         ->check(CLI::IsMember({"pass", "block"}));
     cmd->add_option("--neural-batched-rounds", o.neural.batched_rounds,
                     "leaf rounds through the batched query pass before the per-ray tail pass");

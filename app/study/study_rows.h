@@ -38,8 +38,7 @@ struct StudyRow {
     bool within_2x_floor = false;  // flip <= 2 x noise floor: not distinguishable from noise
     bool converged = false;        // noise floor <= flip / 3, or <= 0.005 (the criterion)
     double queries_per_ray = NAN;
-    double leaf_cap_fraction =
-        NAN; // neural rows: rays (path and shadow) that spent their leaf budget / all rays
+    double leaf_cap_fraction = NAN; // neural rows: rays (path and shadow) at their leaf budget / all rays
     uint32_t equal_time_spp = 0; // classical spp in the hybrid's frame time
     double equal_time_flip = NAN;
     double train_seconds = NAN, final_loss = NAN;

@@ -68,8 +68,7 @@ struct NeuralPlan {
     uint32_t lod_primary = 0, lod_secondary = 0, lod_count = 1; // N-BVH cuts (0 = finest) of the model
     uint32_t leaf_budget = 0;              // leaves queried per camera ray at most (--neural-max-leaves)
     uint32_t leaf_budget_secondary = 0;    // ... per later or shadow ray (--neural-max-leaves-secondary)
-    bool truncated_shadows_block =
-        false; // a shadow ray its budget truncates is occluded (--neural-truncated-shadows)
+    bool truncated_shadows_block = false;  // truncated shadow rays occluded (--neural-truncated-shadows)
     uint32_t batched_rounds_secondary = 0; // batched rounds of their bounces
     uint32_t leaves_per_round = 0; // leaves a ray queues per round
     uint32_t batched_rounds = 0;   // rounds through the batched query pass before neural_tail

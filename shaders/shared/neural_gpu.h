@@ -238,8 +238,8 @@ NB_FN uint nb_split_index(uint k, uint s) {
 struct GpuNeuralCounters {
     uint pending_active;  // pairs the current neural_query dispatch processes
     uint queries_total;   // statistics: queries of the render (path and shadow rays), low 32 bits
-    uint leaf_cap_rays;   // statistics: rays (path and shadow) that spent their leaf budget
-                          // when their leaf budget (max_rounds) was spent: truncated by the cap
+    uint leaf_cap_rays;   // statistics: rays (path and shadow) that spent their leaf budget (the budget
+                          // may have truncated them: a leaf left in front of their best hit)
     uint rounds;          // statistics: rounds with at least one pair
     // High 32 bits of queries_total: the one statistic that grows with the leaf budget (up to max_rounds
     // queries per ray), so that no wave size or --neural-max-leaves can wrap it within a submission (the
