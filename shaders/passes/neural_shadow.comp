@@ -35,15 +35,14 @@ void main() {
         bool capped = st.status == NB_NRAY_PENDING_CAP;
         nb_nl_reduce_group(slot, nb_pair_group(pl.group), st);
         float tmax = uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, pl.ray - cap));
-        // No occluder among the group's hits and the leaf found beyond the budget in front of the
-        // ray's end: truncated, occluded by that leaf (below).
-        if (capped && st.best_t == NB_INF && nb_nl_may_have_more(st, tmax)) st.best_t = 0.0f;
+        // The leaf found beyond the budget in front of the ray's end: truncated, occluded by that leaf.
+        bool blocked = capped && nb_nl_may_have_more(st, tmax);
         // An occluder found, no leaf left (also when the last key lies at or beyond the shadow ray's
         // end) or the budget spent: done without re-traversal.
         if (last || capped || st.best_t < NB_INF || !nb_nl_may_have_more(st, tmax)) {
             st.status = NB_NRAY_DONE;
             nb_state_store(cap + i, st);
-            if (st.best_t < NB_INF) nb_shadow_mark_occluded(i);
+            if (st.best_t < NB_INF || blocked) nb_shadow_mark_occluded(i);
             return;
         }
     } else {
