@@ -79,6 +79,7 @@ nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o
                        {"max_leaves", n.max_rounds},
                        {"max_leaves_secondary", render::effective_secondary_leaves(n)},
                        {"leaves_per_round", n.leaves_per_round},
+                       {"leaves_per_round_camera", n.leaves_per_round_camera},
                        {"batched_rounds", n.batched_rounds},
                        {"occupancy", n.occupancy},
                        {"materials", n.materials == render::NeuralMaterials::mix    ? "mix"

@@ -58,7 +58,10 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
     cmd->add_option("--neural-batched-rounds", o.neural.batched_rounds,
                     "leaf rounds through the batched query pass before the per-ray tail pass");
     cmd->add_option("--neural-leaves-per-round", o.neural.leaves_per_round,
-                    "neural leaves a ray queues per traversal round (speculative ones included; same image)");
+                    "neural leaves a ray after the first hit or a shadow ray queues per traversal round "
+                    "(speculative ones included; same image); default 2");
+    cmd->add_option("--neural-leaves-per-round-camera", o.neural.leaves_per_round_camera,
+                    "neural leaves a camera ray queues per traversal round (same image); default 1");
     cmd->add_option_function<std::string>(
            "--neural-occupancy", [&o](const std::string& v) { o.neural.occupancy = v == "on"; },
            "skip neural leaves whose ray segment crosses only empty cells of the model's occupancy masks "

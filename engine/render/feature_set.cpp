@@ -150,7 +150,8 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
     p.leaf_budget = stage.rounds();
     p.leaf_budget_secondary = stage.params().max_rounds_secondary;
     p.truncated_shadows_block = stage.params().truncated_shadows_block != 0u;
-    p.leaves_per_round = stage.leaves_per_round();
+    p.leaves_per_round = stage.params().leaves_per_round;
+    p.leaves_per_round_camera = stage.params().leaves_per_round_camera;
     p.batched_rounds = stage.batched_rounds(false);
     p.batched_rounds_secondary = stage.batched_rounds(true);
     p.occupancy = stage.params().occupancy != 0u;
@@ -229,10 +230,9 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
         s += strfmt("  LoD             camera rays %u, after the first hit %u (the model has %u: 0 = finest)\n",
                     n->lod_primary, n->lod_secondary, n->lod_count);
         s += strfmt("  leaves per ray  at most %u (rays after the first hit and shadow rays %u), %u queued "
-                    "per round: "
-                    "%u batched round%s (the others %u), then neural_tail\n",
-                    n->leaf_budget, n->leaf_budget_secondary, n->leaves_per_round, n->batched_rounds,
-                    n->batched_rounds == 1 ? "" : "s", n->batched_rounds_secondary);
+                    "per round (the others %u): %u batched round%s (the others %u), then neural_tail\n",
+                    n->leaf_budget, n->leaf_budget_secondary, n->leaves_per_round_camera, n->leaves_per_round,
+                    n->batched_rounds, n->batched_rounds == 1 ? "" : "s", n->batched_rounds_secondary);
         s += strfmt(
             "  truncated rays  %s\n",
             n->truncated_shadows_block

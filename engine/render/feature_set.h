@@ -70,7 +70,8 @@ struct NeuralPlan {
     uint32_t leaf_budget_secondary = 0;    // ... per later or shadow ray (--neural-max-leaves-secondary)
     bool truncated_shadows_block = false;  // truncated shadow rays occluded (--neural-truncated-shadows)
     uint32_t batched_rounds_secondary = 0; // batched rounds of their bounces
-    uint32_t leaves_per_round = 0; // leaves a ray queues per round
+    uint32_t leaves_per_round = 0;        // leaves a ray after the first hit or a shadow ray queues per round
+    uint32_t leaves_per_round_camera = 0; // ... a camera ray
     uint32_t batched_rounds = 0;   // rounds through the batched query pass before neural_tail
     bool occupancy = false;        // leaves skipped by the model's occupancy masks (on and the model has them)
     bool model_has_masks = false;

@@ -15,10 +15,12 @@
 namespace nbvh::render {
 
 uint32_t effective_leaves_per_round(const NeuralRenderOptions& o) {
-    const uint32_t k = o.leaves_per_round;
+    const uint32_t k = o.leaves_per_round, k0 = o.leaves_per_round_camera;
     if (k == 0 || k > NB_NL_MAX_LEAVES_PER_ROUND)
         throw Error(strfmt("--neural-leaves-per-round must be in 1..%u", NB_NL_MAX_LEAVES_PER_ROUND));
-    return k;
+    if (k0 == 0 || k0 > NB_NL_MAX_LEAVES_PER_ROUND)
+        throw Error(strfmt("--neural-leaves-per-round-camera must be in 1..%u", NB_NL_MAX_LEAVES_PER_ROUND));
+    return std::max(k, k0);
 }
 
 uint32_t effective_secondary_leaves(const NeuralRenderOptions& o) {
@@ -124,7 +126,7 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
             uint64_t(double(limits.device_local_bytes) * std::clamp(memory_share, 0.0f, 1.0f) * 0.5);
         const uint64_t bytes =
             limits.device_local_bytes ? std::min(limits.buffer_bytes, share) : limits.buffer_bytes;
-        const uint64_t pairs = uint64_t(params_.leaves_per_round) * std::max(capacity_, 1u);
+        const uint64_t pairs = uint64_t(leaves_per_round()) * std::max(capacity_, 1u);
         params_.split_chunk = plan_split_query(pairs, bytes, o.split_chunk_limit);
         split_fills_ = params_.split_chunk > 0 && params_.split_chunk < pairs;
     }
@@ -193,12 +195,14 @@ const std::vector<uint32_t>& NeuralStage::model_bindings() {
 
 void NeuralStage::set_params(const NeuralRenderOptions& o) {
     rounds_ = o.max_rounds;
-    params_.leaves_per_round = effective_leaves_per_round(o);
-    // Every round queues leaves_per_round leaves per ray still going, or finishes it (fewer leaves left
-    // in front of its hit): after ceil(max_rounds / leaves_per_round) rounds no ray is left.
-    const uint32_t k = params_.leaves_per_round;
+    effective_leaves_per_round(o); // validates both round sizes
+    params_.leaves_per_round = o.leaves_per_round;
+    params_.leaves_per_round_camera = o.leaves_per_round_camera;
+    // Every round queues K leaves per ray still going, or finishes it (fewer leaves left in front of its
+    // hit): after ceil(budget / K) rounds no ray is left (camera rays: their budget and round size).
+    const uint32_t k = params_.leaves_per_round, k0 = params_.leaves_per_round_camera;
     const uint32_t secondary_budget = effective_secondary_leaves(o);
-    batched_ = std::min((o.max_rounds + k - 1) / k, o.batched_rounds);
+    batched_ = std::min((o.max_rounds + k0 - 1) / k0, o.batched_rounds);
     batched_secondary_ = std::min((secondary_budget + k - 1) / k, o.batched_rounds);
     params_.box = model_.box();
     params_.lod_primary = std::min(o.lod, model_.lod_count() - 1);
@@ -242,8 +246,9 @@ void NeuralStage::install_model(std::vector<vk::Buffer>& buffers) {
 void NeuralStage::install(std::vector<vk::Buffer>& buffers) {
     install_model(buffers);
     // Two halves (ping-pong between a query round and the traversal that follows it) of
-    // leaves_per_round pairs per ray, one binding each (lib/neural_bindings.glsl nb_pending_load).
-    const uint64_t half_bytes = uint64_t(params_.leaves_per_round) * std::max(capacity_, 1u) * sizeof(GpuPendingLeaf);
+    // leaves_per_round() pairs per ray, one binding each (lib/neural_bindings.glsl nb_pending_load).
+    const uint64_t half_bytes =
+        uint64_t(leaves_per_round()) * std::max(capacity_, 1u) * sizeof(GpuPendingLeaf);
     for (uint32_t b : {NB_BIND_PENDING_LEAVES, NB_BIND_PENDING_LEAVES_1}) {
         buffers[b] = vk::Buffer(ctx_, half_bytes, vk::MemoryKind::device, 0, "pending leaves");
         buffers[b].fill(0u);

@@ -75,7 +75,15 @@ struct NeuralRenderOptions {
     // 2: fewer wasted speculative queries than 4, fewer rounds than 1, and half the pending pairs of 4,
     // so a 1080p hybrid wave holds 8 samples (H200, 1080p 16 spp, results/perf/knobs_h200.txt: default
     // scene 7.03 -> 6.62 ms per sample, dragon 3.89 -> 3.48 with the 16M-path waves, same images).
+    // Rays after the first hit and shadow rays; camera rays take leaves_per_round_camera.
     uint32_t leaves_per_round = 2;
+    // Leaves a camera ray queues per round (1..NB_NL_MAX_LEAVES_PER_ROUND; same image for any value).
+    // 1: a camera ray's first leaf mostly answers it, so the second leaf that 2 queries beside it is
+    // mostly wasted, while rays after the first hit (budget 2) do better with both leaves in one round.
+    // H200, 1080p 16 spp, secondary budget 1 (where only camera rays queue more than one leaf): dragon
+    // 1.221 -> 1.133 ms per sample with 1 instead of 2 (results/perf/camera_round_h200/).
+    // --neural-leaves-per-round-camera.
+    uint32_t leaves_per_round_camera = 1;
     float threshold = NB_VISIBILITY_THRESHOLD;
     // Skip (ray, leaf) pairs whose segment crosses only empty cells of the leaf's occupancy mask
     // (shared/neural_occupancy.h; models without masks query every leaf). --neural-occupancy on|off.
@@ -107,7 +115,8 @@ struct NeuralRenderOptions {
     uint32_t split_min_pairs = DEFAULT_SPLIT_MIN_PAIRS;
 };
 
-// Leaves per round of `options` (throws nbvh::Error when out of range).
+// Pending-queue pairs per ray of `options`: the larger of its leaves per round of camera rays and of the
+// others (throws nbvh::Error when either is out of range).
 uint32_t effective_leaves_per_round(const NeuralRenderOptions& options);
 // The leaf budget of rays after the first hit and of shadow rays: max_rounds_secondary, at most
 // max_rounds (0: max_rounds).
@@ -170,7 +179,10 @@ public:
     // an argument the larger (command and timer sizing).
     uint32_t batched_rounds() const { return std::max(batched_, batched_secondary_); }
     uint32_t batched_rounds(bool secondary) const { return secondary ? batched_secondary_ : batched_; }
-    uint32_t leaves_per_round() const { return params_.leaves_per_round; }
+    // Pending-queue pairs per ray (the larger of the two round sizes).
+    uint32_t leaves_per_round() const {
+        return std::max(params_.leaves_per_round, params_.leaves_per_round_camera);
+    }
     const GpuNeuralParams& params() const { return params_; }
     const std::vector<GpuNeuralAsset>& assets() const { return assets_; }
 

@@ -23,8 +23,9 @@ uint g_nl_last_inst = 0u;
 uint g_nl_last_leaf = 0u;
 // The g_nl_want smallest keys above the last queued one, sorted (g_nl_cand_n of them so far).
 uint g_nl_want = 1u;
-// The ray's leaf budget (nb_nl_budget), set by each pass before its first traversal.
+// The ray's leaf budget and round size (nb_nl_set_class), set by each pass before its first traversal.
 uint g_nl_budget = 1u;
+uint g_nl_per_round = 1u;
 // Set when the ray was found truncated by its leaf budget (a leaf left in front of its best hit).
 bool g_nl_truncated = false;
 // Shadow rays under --neural-truncated-shadows block: a round that spends the budget looks for one
@@ -137,10 +138,12 @@ void nb_traverse_neural_instance(uint instance) {
 uint nb_nl_op(uint mode) { return mode & 3u; }
 uint nb_nl_half(uint mode) { return (mode >> 2u) & 1u; }
 
-// Leaves a ray may query in all: camera rays neural_params.max_rounds, rays after the first hit and shadow
-// rays max_rounds_secondary (--neural-max-leaves-secondary).
-uint nb_nl_budget(bool camera_ray) {
-    return camera_ray ? neural_params.max_rounds : neural_params.max_rounds_secondary;
+// The leaves a ray may query in all (g_nl_budget: camera rays neural_params.max_rounds, rays after the
+// first hit and shadow rays max_rounds_secondary, --neural-max-leaves-secondary) and per round
+// (g_nl_per_round: leaves_per_round_camera or leaves_per_round).
+void nb_nl_set_class(bool camera_ray) {
+    g_nl_budget = camera_ray ? neural_params.max_rounds : neural_params.max_rounds_secondary;
+    g_nl_per_round = camera_ray ? neural_params.leaves_per_round_camera : neural_params.leaves_per_round;
 }
 
 // Leaves a ray's next traversal looks for: the round size, within its leaf budget (g_nl_budget). Under
@@ -149,7 +152,7 @@ uint nb_nl_budget(bool camera_ray) {
 // the budget truncated the ray (NB_NRAY_PENDING_CAP), without the re-traversal that would find it.
 uint nb_nl_want(GpuNeuralRayState st) {
     uint left = g_nl_budget > st.rounds ? g_nl_budget - st.rounds : 0u;
-    uint k = max(1u, min(min(neural_params.leaves_per_round, NB_NL_MAX_LEAVES_PER_ROUND), left));
+    uint k = max(1u, min(min(g_nl_per_round, NB_NL_MAX_LEAVES_PER_ROUND), left));
     return g_nl_probe && k == left && k < NB_NL_MAX_LEAVES_PER_ROUND ? k + 1u : k;
 }
 

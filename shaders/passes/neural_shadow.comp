@@ -18,7 +18,7 @@ void main() {
     uint op = nb_nl_op(pc.mode);
     uint half_ = nb_nl_half(pc.mode);
     uint cap = ray_capacity();
-    g_nl_budget = nb_nl_budget(false);
+    nb_nl_set_class(false);
     g_nl_probe = neural_params.truncated_shadows_block != 0u;
     uint i;
     GpuNeuralRayState st;

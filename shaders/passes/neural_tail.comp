@@ -37,7 +37,7 @@ void main() {
     g_alpha_seed = shadow ? nb_shadow_alpha_seed(shadow_load1(NB_SHADOW_PIXEL, i) & ~NB_RAY_BACKFACE_BIT)
                           : ray_load1(pc.in_queue, NB_RAY_RNG, i);
     uint lod = (shadow || pc.depth != 0u) ? neural_params.lod_secondary : neural_params.lod_primary;
-    g_nl_budget = nb_nl_budget(!shadow && pc.depth == 0u);
+    nb_nl_set_class(!shadow && pc.depth == 0u);
     g_nl_probe = shadow && neural_params.truncated_shadows_block != 0u;
     GpuNeuralRayState st = nb_state_load(ray);
     bool last = st.status == NB_NRAY_PENDING_LAST; // no leaf left behind this group

@@ -21,7 +21,7 @@ void main() {
     uint op = nb_nl_op(pc.mode);
     uint half_ = nb_nl_half(pc.mode);
     uint q = pc.in_queue;
-    g_nl_budget = nb_nl_budget(pc.depth == 0u);
+    nb_nl_set_class(pc.depth == 0u);
     uint i;
     GpuNeuralRayState st;
     if (op == 1u) {

@@ -162,7 +162,9 @@ struct GpuNeuralParams {
     float metallic;       // < 0: the asset's material; else --neural-metallic
     float threshold;      // visibility threshold
     uint max_rounds;      // leaves queried per ray at most (then the best hit so far is kept)
-    uint leaves_per_round; // 1..NB_NL_MAX_LEAVES_PER_ROUND leaves queued per ray per traversal round
+    // 1..NB_NL_MAX_LEAVES_PER_ROUND leaves queued per traversal round by rays after the first hit and
+    // by shadow rays (--neural-leaves-per-round); camera rays: leaves_per_round_camera.
+    uint leaves_per_round;
     // Occupancy masks (shared/neural_occupancy.h): their first word in the node-bounds buffer
     // (NB_BIND_NBVH_BOUNDS seen as words, after the NB_NBVH_BOUNDS_WORDS per node of the bounds), 0 =
     // none or off.
@@ -187,7 +189,9 @@ struct GpuNeuralParams {
     uint max_rounds_secondary;
     // 1: a shadow ray truncated by its leaf budget is occluded (--neural-truncated-shadows block).
     uint truncated_shadows_block;
-    uint pad2;
+    // 1..NB_NL_MAX_LEAVES_PER_ROUND leaves queued per traversal round by camera rays
+    // (--neural-leaves-per-round-camera). The pending queue holds the larger of the two per ray.
+    uint leaves_per_round_camera;
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 96, "GpuNeuralParams layout");
 

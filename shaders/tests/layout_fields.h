@@ -112,9 +112,10 @@
     F(box.extent)                                                                                            \
     F(box.fixed_depth_eps)                                                                                   \
     F(lod_primary)                                                                                           \
-    F(lod_secondary) F(roughness) F(metallic) F(threshold) F(max_rounds) F(leaves_per_round) F(occupancy)    \
-        F(materials) F(material_fits) F(material_spread) F(split_chunk) F(split_min_pairs)                   \
-            F(max_rounds_secondary) F(truncated_shadows_block) F(pad2)
+    F(lod_secondary)                                                                                         \
+    F(roughness) F(metallic) F(threshold) F(max_rounds) F(leaves_per_round) F(occupancy) F(materials)        \
+        F(material_fits) F(material_spread) F(split_chunk) F(split_min_pairs) F(max_rounds_secondary)        \
+            F(truncated_shadows_block) F(leaves_per_round_camera)
 #define NB_LAYOUT_FIELDS_GpuNeuralCounters(F)                                                                \
     F(pending_active)                                                                                        \
     F(queries_total)                                                                                         \

@@ -31,8 +31,8 @@ TEST(CliExplain, HybridRenderListsTheNeuralPasses) {
     EXPECT_TRUE(has(o, "MLP path        scalar")) << o;
     EXPECT_TRUE(has(o, "camera rays 1, after the first hit 0 (the model has 2")) << o;
     // the defaults
-    EXPECT_TRUE(has(o, "at most 8 (rays after the first hit and shadow rays 2), 2 queued per round: 4 "
-                       "batched rounds (the others 1)"))
+    EXPECT_TRUE(has(o, "at most 8 (rays after the first hit and shadow rays 2), 1 queued per round (the "
+                       "others 2): 8 batched rounds (the others 1)"))
         << o;
     EXPECT_TRUE(has(o, "truncated rays  a shadow ray is occluded")) << o;
     EXPECT_TRUE(has(o, "occupancy masks on")) << o;
@@ -75,9 +75,22 @@ TEST(CliExplain, LeavesPerRoundComeFromTheRenderersStage) {
     // --neural-leaves-per-round reaches the renderer's stage (it was a hidden environment variable).
     const auto r = run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round", "3"}), 60.0);
     ASSERT_EQ(r.exit_code, 0) << r.describe();
-    EXPECT_TRUE(has(r.out, "at most 8 (rays after the first hit and shadow rays 2), 3 queued per round: 3 "
-                           "batched rounds (the others 1)"))
+    EXPECT_TRUE(has(r.out, "at most 8 (rays after the first hit and shadow rays 2), 1 queued per round (the "
+                           "others 3): 8 batched rounds (the others 1)"))
         << r.out;
+    // --neural-leaves-per-round-camera: the camera rays' rounds.
+    const auto c =
+        run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round-camera", "3"}), 60.0);
+    ASSERT_EQ(c.exit_code, 0) << c.describe();
+    EXPECT_TRUE(has(c.out, "at most 8 (rays after the first hit and shadow rays 2), 3 queued per round (the "
+                           "others 2): 3 batched rounds (the others 1)"))
+        << c.out;
+    for (const char* bad : {"0", "5"}) {
+        const auto e = run_nbvh(
+            explain({"--model", tiny_model().string(), "--neural-leaves-per-round-camera", bad}), 60.0);
+        EXPECT_EQ(check_clean_error(e, {"--neural-leaves-per-round-camera"}, false), "") << bad << "\n"
+                                                                                         << e.describe();
+    }
     // The secondary leaf budget, never above the camera rays'.
     const auto s = run_nbvh(explain({"--model", tiny_model().string(), "--neural-max-leaves", "3",
                                      "--neural-max-leaves-secondary", "6"}),

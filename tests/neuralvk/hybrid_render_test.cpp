@@ -77,6 +77,7 @@ Tweak rounds(uint32_t batched, uint32_t leaves_per_round, uint32_t max_leaves = 
     return [=](RenderOptions& o) {
         o.neural.batched_rounds = batched;
         o.neural.leaves_per_round = leaves_per_round;
+        o.neural.leaves_per_round_camera = leaves_per_round;
         o.neural.max_rounds = max_leaves;
         o.neural.max_rounds_secondary = 0;
     };
@@ -311,6 +312,44 @@ TEST(HybridRender, LeavesPerRoundKeepTheImage) {
     EXPECT_LT(k4.stats.neural_rounds, k1.stats.neural_rounds);
 }
 
+// Camera rays' own round size (--neural-leaves-per-round-camera) beside the others' (the default
+// budgets, 8 and 2, and 2 leaves per round after the first hit): the same image and the same queries
+// after the first hit whatever the camera rays queue per round; their queries grow and their rounds
+// shrink with it, with all rounds batched and with the tail after one.
+TEST(HybridRender, CameraLeavesPerRoundKeepTheImage) {
+    NBVH_REQUIRE_SHARED();
+    const Fixture& f = trained_bunny();
+    for (uint32_t batched : {256u, 1u}) {
+        std::vector<Rendered> r;
+        for (uint32_t k0 : {1u, 2u, 4u})
+            r.push_back(render_bunny(f, true, [=](RenderOptions& o) {
+                o.neural.batched_rounds = batched;
+                o.neural.leaves_per_round_camera = k0;
+            }));
+        for (size_t i = 0; i < r.size(); ++i) {
+            EXPECT_EQ(r[i].validation, 0);
+            std::printf(
+                "%u batched rounds, camera rays %u leaves per round: queries %llu (camera rays %llu), "
+                "rounds %llu\n",
+                batched, 1u << i, (unsigned long long)r[i].stats.neural_queries,
+                (unsigned long long)r[i].stats.neural_queries_by_depth.at(0),
+                (unsigned long long)r[i].stats.neural_rounds);
+        }
+        for (size_t i = 1; i < r.size(); ++i) {
+            EXPECT_LT(flip_hdr(r[0].image, r[i].image).mean, 1e-3f) << i;
+            EXPECT_GE(r[i].stats.neural_queries_by_depth.at(0), r[i - 1].stats.neural_queries_by_depth.at(0))
+                << i;
+            for (size_t d = 1; d < r[0].stats.neural_queries_by_depth.size(); ++d)
+                EXPECT_EQ(r[i].stats.neural_queries_by_depth.at(d), r[0].stats.neural_queries_by_depth.at(d))
+                    << i;
+        }
+        EXPECT_GT(r[2].stats.neural_queries_by_depth.at(0), r[0].stats.neural_queries_by_depth.at(0));
+        if (batched == 256u) {
+            EXPECT_LT(r[2].stats.neural_rounds, r[0].stats.neural_rounds);
+        }
+    }
+}
+
 // The ray order (--sort-rays) in a hybrid render: the neural traversal's op 0 and the neural shadow rays
 // take the rays in ray-sort order; the image and the queries stay those of queue order, with one leaf per
 // round and with several, with and without the tail pass.
@@ -416,6 +455,11 @@ TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
     o.leaves_per_round = NB_NL_MAX_LEAVES_PER_ROUND + 1;
     EXPECT_THROW(validate(o, f.scene), Error);
     o.leaves_per_round = 2;
+    o.leaves_per_round_camera = 0;
+    EXPECT_THROW(validate(o, f.scene), Error);
+    o.leaves_per_round_camera = NB_NL_MAX_LEAVES_PER_ROUND + 1;
+    EXPECT_THROW(validate(o, f.scene), Error);
+    o.leaves_per_round_camera = 1;
     EXPECT_NO_THROW(validate(o, f.scene));
     Scene plain = f.scene;
     for (Instance& i : plain.instances) i.neural = false;
