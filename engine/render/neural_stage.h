@@ -80,9 +80,9 @@ struct NeuralRenderOptions {
     // Leaves a camera ray queues per round (1..NB_NL_MAX_LEAVES_PER_ROUND; same image for any value).
     // 1: a camera ray's first leaf mostly answers it, so the second leaf that 2 queries beside it is
     // mostly wasted, while rays after the first hit (budget 2) do better with both leaves in one round.
-    // H200, 1080p 16 spp, secondary budget 1 (where only camera rays queue more than one leaf): dragon
-    // 1.221 -> 1.133 ms per sample with 1 instead of 2 (results/perf/camera_round_h200/).
-    // --neural-leaves-per-round-camera.
+    // H200, 1080p 16 spp, 1 instead of 2: default scene 3.547 -> 3.471 ms per sample, dragon 1.555 ->
+    // 1.467, Chess 4.795 -> 4.710, same images (results/perf/camera_round_h200/; 1 for every ray is
+    // slower: dragon 1.554 -> 1.650). --neural-leaves-per-round-camera.
     uint32_t leaves_per_round_camera = 1;
     float threshold = NB_VISIBILITY_THRESHOLD;
     // Skip (ray, leaf) pairs whose segment crosses only empty cells of the leaf's occupancy mask
