@@ -31,6 +31,7 @@
 #include "engine/neural/model_file.h"
 #include "engine/render/decimation.h"
 #include "engine/render/gpu_memory.h"
+#include "engine/render/neural_stage.h"
 #include "engine/render/wavefront.h"
 #include "engine/vk/context.h"
 #include "trainer/compact_hash.h"
@@ -126,6 +127,7 @@ void StudyRun::write_results() const {
           {"max_leaves_secondary", o_.render.neural.max_rounds_secondary}, // 0: max_leaves; the cap row: 0
           {"cap_study", o_.cap_study},
           {"leaves_per_round", o_.render.neural.leaves_per_round},
+          {"leaves_per_round_camera", o_.render.neural.leaves_per_round_camera},
           {"neural_path", render::neural_path_name(neural_path_)},
           {"sampler", render::sampler_name(o_.render.sampler)},
           {"image_wave_memory_share", image_memory_share_},
@@ -135,7 +137,7 @@ void StudyRun::write_results() const {
           {"references", o_.references_dir},
           {"equal_time_upto", o_.equal_time_upto},
           {"neural_scratch_bytes_per_ray",
-           render::neural_scratch_bytes_per_ray(o_.render.neural.leaves_per_round)}}},
+           render::neural_scratch_bytes_per_ray(render::effective_leaves_per_round(o_.render.neural))}}},
         {"flip_metric",
          "LDR-FLIP (ppd 67.02) of ACES-tone-mapped 8-bit sRGB images, one exposure per camera"},
         {"cameras", cams},
