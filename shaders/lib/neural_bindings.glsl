@@ -56,9 +56,11 @@ void nb_state_store(uint i, GpuNeuralRayState st) {
     neural_state[4u * i + 3u] = uvec4(floatBitsToUint(st.tri_t), st.tri_instance, st.tri_triangle, st.rounds);
 }
 
-// Slot k of half `half_` of the pending queue (each half holds leaves_per_round pairs per ray, in its
-// own binding: half 1's slots start at the half size).
-uint nb_nl_half_size() { return ray_capacity() * max(neural_params.leaves_per_round, neural_params.leaves_per_round_camera); }
+// Slot k of half `half_` of the pending queue (each half holds the larger of the two round sizes'
+// pairs per ray, in its own binding: half 1's slots start at the half size).
+uint nb_nl_half_size() {
+    return ray_capacity() * max(neural_params.leaves_per_round, neural_params.leaves_per_round_camera);
+}
 uint nb_nl_pending_index(uint half_, uint k) { return half_ * nb_nl_half_size() + k; }
 // A pending pair as the passes use it (stored as shared/wavefront_gpu.h GpuPendingLeaf: `ray` and
 // `group` packed in one word, the record 3 uvec4 of the pending bindings).

@@ -66,7 +66,7 @@ NB_FN uint nb_shadow_word(uint field, uint capacity, uint index, uint components
 struct GpuPendingLeaf {
     // The ray and its group, packed (nb_pair_pack_ray_group): bits 0-26 the ray (a slot in the current
     // path-ray queue, or ray capacity + a shadow-ray slot); bits 27-30 the group: a ray queues up to
-    // GpuNeuralParams.leaves_per_round pairs per round, contiguously, in key order, and the first one
+    // GpuNeuralParams.leaves_per_round(_camera) pairs per round, contiguously, in key order, and the first one
     // holds their count (its resumed traversal reduces them), the others 0 (nb_pair_group); bit 31
     // (NB_RAY_BACKFACE_BIT) set: the ray's query skips back-facing hits (every pair of the ray).
     uint ray_group;
