@@ -78,6 +78,8 @@ nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o
                        {"visibility_threshold", n.threshold},
                        {"max_leaves", n.max_rounds},
                        {"max_leaves_secondary", render::effective_secondary_leaves(n)},
+                       {"max_leaves_shadow", render::effective_shadow_leaves(n)},
+                       {"truncated_shadows_occlusion", n.truncated_shadows_occlusion},
                        {"leaves_per_round", n.leaves_per_round},
                        {"leaves_per_round_camera", n.leaves_per_round_camera},
                        {"batched_rounds", n.batched_rounds},

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "app/scene_arg.h"
 #include "engine/core/error.h"
@@ -42,19 +43,34 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
                     "neural leaves queried per ray at most (then the closest hit so far is kept)");
     cmd->add_option(
            "--neural-max-leaves-secondary", o.neural.max_rounds_secondary,
-           "neural leaves queried per ray at most by rays after the first hit and by shadow rays, at most "
-           "--neural-max-leaves (a truncated ray keeps its closest hit so far; a truncated shadow ray: "
-           "--neural-truncated-shadows); 0: --neural-max-leaves; default 2")
+           "neural leaves queried per ray at most by rays after the first hit (and by shadow rays, unless "
+           "--neural-max-leaves-shadow), at most --neural-max-leaves (a truncated ray keeps its closest hit "
+           "so far); 0: --neural-max-leaves; default 2")
+        ->check(CLI::Range(0u, 256u));
+    cmd->add_option("--neural-max-leaves-shadow", o.neural.max_rounds_shadow,
+                    "neural leaves queried per shadow ray at most, at most --neural-max-leaves (a truncated "
+                    "shadow ray: --neural-truncated-shadows); 0 (default): --neural-max-leaves-secondary")
         ->check(CLI::Range(0u, 256u));
     cmd->add_option_function<std::string>(
            "--neural-truncated-shadows",
-           [&o](const std::string& v) { o.neural.truncated_shadows_block = v == "block"; },
+           [&o](const std::string& v) {
+               o.neural.truncated_shadows_occlusion = v == "block" ? 1.0f : v == "pass" ? 0.0f : std::stof(v);
+           },
            "a shadow ray truncated by its leaf budget (a leaf left in front of its end; with occupancy "
-           "masks, "
-           "one whose cells along the ray are occupied): occluded by that leaf (block, default) or "
-           "unoccluded "
-           "(pass)")
-        ->check(CLI::IsMember({"pass", "block"}));
+           "masks, one whose cells along the ray are occupied): occluded by that leaf (block, default), "
+           "unoccluded (pass), or occluded with probability P in [0, 1] (a hash of the ray)")
+        ->check([](const std::string& v) -> std::string {
+            if (v == "block" || v == "pass") return "";
+            size_t used = 0;
+            float p = -1.0f;
+            try {
+                p = std::stof(v, &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            return used == v.size() && p >= 0.0f && p <= 1.0f ? ""
+                                                               : "must be block, pass or a probability in [0, 1]";
+        });
     cmd->add_option("--neural-batched-rounds", o.neural.batched_rounds,
                     "leaf rounds through the batched query pass before the per-ray tail pass");
     cmd->add_option("--neural-leaves-per-round", o.neural.leaves_per_round,

@@ -167,7 +167,7 @@ void StudyRun::run_config(size_t index, const Config& c) {
             vo.neural.secondary_lod = v.secondary;
             vo.neural.max_rounds = v.max_leaves;
             // The cap row raises every ray's budget (its image change is what the default budgets cost).
-            if (v.kind == "cap") vo.neural.max_rounds_secondary = 0;
+            if (v.kind == "cap") vo.neural.max_rounds_secondary = vo.neural.max_rounds_shadow = 0;
             const std::string what =
                 v.kind == "switch" ? strfmt("LoD %d, then %d after the first hit", v.lod, v.secondary)
                 : v.kind == "cap"  ? strfmt("LoD %d, <= %u leaves per ray", v.lod, v.max_leaves)

@@ -97,8 +97,9 @@ class StudyRun {
         if (lods > 1) v.push_back({"switch", 0, int(lods - 1), cap, o_.equal_time});
         // The cap row raises every ray's budget (study_config.cpp), so it differs from the others also
         // where cap_study is the camera rays' budget but later rays have less.
-        const uint32_t secondary = o_.render.neural.max_rounds_secondary;
-        const bool cap_differs = o_.cap_study != cap || (secondary != 0 && secondary < cap);
+        const uint32_t secondary = o_.render.neural.max_rounds_secondary, shadow = o_.render.neural.max_rounds_shadow;
+        const bool cap_differs =
+            o_.cap_study != cap || (secondary != 0 && secondary < cap) || (shadow != 0 && shadow < cap);
         if (o_.cap_study && cap_differs && config == configs_.size() / 2)
             v.push_back({"cap", 0, 0, o_.cap_study, false});
         return v;

@@ -125,6 +125,7 @@ void StudyRun::write_results() const {
           {"repeat", o_.repeat},
           {"max_leaves", o_.render.neural.max_rounds},
           {"max_leaves_secondary", o_.render.neural.max_rounds_secondary}, // 0: max_leaves; the cap row: 0
+          {"max_leaves_shadow", o_.render.neural.max_rounds_shadow}, // 0: max_leaves_secondary; the cap row: 0
           {"cap_study", o_.cap_study},
           {"leaves_per_round", o_.render.neural.leaves_per_round},
           {"leaves_per_round_camera", o_.render.neural.leaves_per_round_camera},

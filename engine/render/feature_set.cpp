@@ -149,11 +149,13 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
     p.lod_count = std::max(1u, o.model->lod_count);
     p.leaf_budget = stage.rounds();
     p.leaf_budget_secondary = stage.params().max_rounds_secondary;
-    p.truncated_shadows_block = stage.params().truncated_shadows_block != 0u;
+    p.truncated_shadows_occlusion = stage.params().truncated_shadows_occlusion;
     p.leaves_per_round = stage.params().leaves_per_round;
     p.leaves_per_round_camera = stage.params().leaves_per_round_camera;
-    p.batched_rounds = stage.batched_rounds(false);
-    p.batched_rounds_secondary = stage.batched_rounds(true);
+    p.batched_rounds = stage.batched_rounds(NeuralStage::RayClass::camera);
+    p.batched_rounds_secondary = stage.batched_rounds(NeuralStage::RayClass::path);
+    p.batched_rounds_shadow = stage.batched_rounds(NeuralStage::RayClass::shadow);
+    p.leaf_budget_shadow = stage.params().max_rounds_shadow;
     p.occupancy = stage.params().occupancy != 0u;
     p.model_has_masks = !o.model->occupancy.empty();
     p.backface_escape = o.backface_escape;
@@ -229,16 +231,21 @@ std::string explain(const SceneFeatures& f, uint32_t max_depth, const NeuralPlan
         s += strfmt("  MLP path        %s\n", n->kernel.c_str());
         s += strfmt("  LoD             camera rays %u, after the first hit %u (the model has %u: 0 = finest)\n",
                     n->lod_primary, n->lod_secondary, n->lod_count);
-        s += strfmt("  leaves per ray  at most %u (rays after the first hit and shadow rays %u), %u queued "
-                    "per round (the others %u): %u batched round%s (the others %u), then neural_tail\n",
-                    n->leaf_budget, n->leaf_budget_secondary, n->leaves_per_round_camera, n->leaves_per_round,
-                    n->batched_rounds, n->batched_rounds == 1 ? "" : "s", n->batched_rounds_secondary);
-        s += strfmt(
-            "  truncated rays  %s\n",
-            n->truncated_shadows_block
-                ? "a shadow ray is occluded by the leaf its budget leaves out, a path ray keeps its closest "
-                  "hit"
-                : "keep their closest hit, a shadow ray is unoccluded (--neural-truncated-shadows pass)");
+        s += strfmt("  leaves per ray  at most %u (rays after the first hit %u, shadow rays %u), %u queued "
+                    "per round (the others %u): %u batched round%s (the others %u, shadow rays %u), then "
+                    "neural_tail\n",
+                    n->leaf_budget, n->leaf_budget_secondary, n->leaf_budget_shadow, n->leaves_per_round_camera,
+                    n->leaves_per_round, n->batched_rounds, n->batched_rounds == 1 ? "" : "s",
+                    n->batched_rounds_secondary, n->batched_rounds_shadow);
+        const float occl = n->truncated_shadows_occlusion;
+        s += occl >= 1.0f ? std::string("  truncated rays  a shadow ray is occluded by the leaf its budget leaves "
+                                        "out, a path ray keeps its closest hit\n")
+             : occl <= 0.0f
+                 ? std::string("  truncated rays  keep their closest hit, a shadow ray is unoccluded "
+                               "(--neural-truncated-shadows pass)\n")
+                 : strfmt("  truncated rays  a shadow ray is occluded by the leaf its budget leaves out with "
+                          "probability %.3g, a path ray keeps its closest hit\n",
+                          occl);
         s += strfmt("  occupancy masks %s\n", n->occupancy          ? "on  (leaves crossing only empty cells are not queried)"
                                               : n->model_has_masks ? "off (--neural-occupancy off)"
                                                                    : "off (the model has no masks: format version < 3 or built without its triangles)");

@@ -67,9 +67,11 @@ struct NeuralPlan {
     bool split_fused_rest = false; // ... and the fused pass after them (NeuralStage::split_overflow)
     uint32_t lod_primary = 0, lod_secondary = 0, lod_count = 1; // N-BVH cuts (0 = finest) of the model
     uint32_t leaf_budget = 0;              // leaves queried per camera ray at most (--neural-max-leaves)
-    uint32_t leaf_budget_secondary = 0;    // ... per later or shadow ray (--neural-max-leaves-secondary)
-    bool truncated_shadows_block = false;  // truncated shadow rays occluded (--neural-truncated-shadows)
+    uint32_t leaf_budget_secondary = 0;    // ... per ray after the first hit (--neural-max-leaves-secondary)
+    uint32_t leaf_budget_shadow = 0;       // ... per shadow ray (--neural-max-leaves-shadow)
+    float truncated_shadows_occlusion = 0; // truncated shadow rays occluded with it (--neural-truncated-shadows)
     uint32_t batched_rounds_secondary = 0; // batched rounds of their bounces
+    uint32_t batched_rounds_shadow = 0;    // ... of shadow rays
     uint32_t leaves_per_round = 0;        // leaves a ray after the first hit or a shadow ray queues per round
     uint32_t leaves_per_round_camera = 0; // ... a camera ray
     uint32_t batched_rounds = 0;   // rounds through the batched query pass before neural_tail

@@ -27,12 +27,19 @@ uint32_t effective_secondary_leaves(const NeuralRenderOptions& o) {
     return o.max_rounds_secondary ? std::min(o.max_rounds_secondary, o.max_rounds) : o.max_rounds;
 }
 
+uint32_t effective_shadow_leaves(const NeuralRenderOptions& o) {
+    return o.max_rounds_shadow ? std::min(o.max_rounds_shadow, o.max_rounds) : effective_secondary_leaves(o);
+}
+
 void validate(const NeuralRenderOptions& o, const Scene& scene) {
     effective_leaves_per_round(o);
     if (!(o.roughness <= 1.0f)) throw Error("--neural-roughness must be in [0, 1]");
     if (!(o.metallic <= 1.0f)) throw Error("--neural-metallic must be in [0, 1]");
     if (o.max_rounds == 0 || o.max_rounds > 256) throw Error("--neural-max-leaves must be in 1..256");
     if (o.max_rounds_secondary > 256) throw Error("--neural-max-leaves-secondary must be in 0..256");
+    if (o.max_rounds_shadow > 256) throw Error("--neural-max-leaves-shadow must be in 0..256");
+    if (!(o.truncated_shadows_occlusion >= 0.0f && o.truncated_shadows_occlusion <= 1.0f))
+        throw Error("--neural-truncated-shadows must be block, pass or a probability in [0, 1]");
     if (o.batched_rounds > 256) throw Error("--neural-batched-rounds must be in 0..256");
     if (!(o.threshold > 0.0f && o.threshold < 1.0f)) throw Error("the visibility threshold must be in (0, 1)");
     bool any = false;
@@ -201,9 +208,10 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     // Every round queues K leaves per ray still going, or finishes it (fewer leaves left in front of its
     // hit): after ceil(budget / K) rounds no ray is left (camera rays: their budget and round size).
     const uint32_t k = params_.leaves_per_round, k0 = params_.leaves_per_round_camera;
-    const uint32_t secondary_budget = effective_secondary_leaves(o);
+    const uint32_t secondary_budget = effective_secondary_leaves(o), shadow_budget = effective_shadow_leaves(o);
     batched_ = std::min((o.max_rounds + k0 - 1) / k0, o.batched_rounds);
     batched_secondary_ = std::min((secondary_budget + k - 1) / k, o.batched_rounds);
+    batched_shadow_ = std::min((shadow_budget + k - 1) / k, o.batched_rounds);
     params_.box = model_.box();
     params_.lod_primary = std::min(o.lod, model_.lod_count() - 1);
     const uint32_t coarsest = model_.lod_count() - 1;
@@ -216,7 +224,8 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     params_.threshold = o.threshold;
     params_.max_rounds = o.max_rounds;
     params_.max_rounds_secondary = secondary_budget;
-    params_.truncated_shadows_block = o.truncated_shadows_block ? 1u : 0u;
+    params_.max_rounds_shadow = shadow_budget;
+    params_.truncated_shadows_occlusion = std::clamp(o.truncated_shadows_occlusion, 0.0f, 1.0f);
     params_.split_min_pairs = o.split_min_pairs;
     params_.occupancy = o.occupancy ? model_.occupancy_offset() : 0u;
     params_.materials = o.materials != NeuralMaterials::asset ? model_.materials_offset() : 0u;

@@ -59,12 +59,18 @@ struct NeuralRenderOptions {
     // the dragon 1.81x -> 1.39x for 0.0031 -> 0.0097, Chess 1.37x -> 1.25x for 0.0305 -> 0.0338.
     // --neural-max-leaves-secondary.
     uint32_t max_rounds_secondary = 2;
-    // A shadow ray truncated by its leaf budget (a leaf with occupied cells left in front of its end):
-    // true, occluded; false, unoccluded. The round that spends a shadow ray's budget then looks for one
-    // leaf more than it queues (no re-traversal). At budget 2 (same call): FLIP 0.0204 -> 0.0185 on the
+    // Leaves queried per shadow ray at most (at most max_rounds; 0: max_rounds_secondary, the default).
+    // Apart from the path rays' budget: a truncated shadow ray leaks or blocks light where a truncated
+    // path ray changes its path. --neural-max-leaves-shadow.
+    uint32_t max_rounds_shadow = 0;
+    // A shadow ray truncated by its leaf budget (a leaf with occupied cells left in front of its end) is
+    // occluded with this probability (a hash of the ray; 1 block, 0 pass): where blocking darkens and
+    // passing brightens, a fraction between them takes light away from some of the rays the unqueried
+    // leaves would block. Above 0 the round that spends a shadow ray's budget looks for one leaf more
+    // than it queues (no re-traversal). 1 against 0 at budget 2 (same call): FLIP 0.0204 -> 0.0185 on the
     // default scene, 0.0384 -> 0.0338 on Chess, 0.0061 -> 0.0097 on the dragon, for +1 % frame time.
-    // --neural-truncated-shadows block|pass.
-    bool truncated_shadows_block = true;
+    // --neural-truncated-shadows block|pass|P.
+    float truncated_shadows_occlusion = 1.0f;
     // Rounds through the batched query pass; rays still going after them finish in neural_tail (one
     // invocation per ray, scalar queries). Default: all rounds batched (the tail measured slower on the
     // H200: its longest ray serialises ~10 scalar queries per pass).
@@ -118,9 +124,11 @@ struct NeuralRenderOptions {
 // Pending-queue pairs per ray of `options`: the larger of its leaves per round of camera rays and of the
 // others (throws nbvh::Error when either is out of range).
 uint32_t effective_leaves_per_round(const NeuralRenderOptions& options);
-// The leaf budget of rays after the first hit and of shadow rays: max_rounds_secondary, at most
+// The leaf budget of rays after the first hit: max_rounds_secondary, at most
 // max_rounds (0: max_rounds).
 uint32_t effective_secondary_leaves(const NeuralRenderOptions& options);
+// The leaf budget of shadow rays: max_rounds_shadow, at most max_rounds (0: effective_secondary_leaves).
+uint32_t effective_shadow_leaves(const NeuralRenderOptions& options);
 
 // Throws nbvh::Error on out-of-range constants (roughness/metallic outside [0,1], rounds 0 or > 256,
 // LoDs beyond the model's, a model with no neural instance in the scene).
@@ -175,10 +183,13 @@ public:
     const vk::Buffer& split_features() const { return split_features_; }
     std::string query_description() const;
     uint32_t rounds() const { return rounds_; }
-    // Batched rounds per bounce of camera rays (secondary = false) or of later and shadow rays; without
-    // an argument the larger (command and timer sizing).
-    uint32_t batched_rounds() const { return std::max(batched_, batched_secondary_); }
-    uint32_t batched_rounds(bool secondary) const { return secondary ? batched_secondary_ : batched_; }
+    // Batched rounds per bounce of camera rays, of rays after the first hit or of shadow rays (each
+    // class's leaf budget over its round size); without an argument the largest (command and timer sizing).
+    enum class RayClass { camera, path, shadow };
+    uint32_t batched_rounds() const { return std::max({batched_, batched_secondary_, batched_shadow_}); }
+    uint32_t batched_rounds(RayClass c) const {
+        return c == RayClass::camera ? batched_ : c == RayClass::path ? batched_secondary_ : batched_shadow_;
+    }
     // Pending-queue pairs per ray (the larger of the two round sizes).
     uint32_t leaves_per_round() const {
         return std::max(params_.leaves_per_round, params_.leaves_per_round_camera);
@@ -202,6 +213,7 @@ private:
     uint32_t rounds_ = 0;
     uint32_t batched_ = 0;
     uint32_t batched_secondary_ = 0;
+    uint32_t batched_shadow_ = 0;
     uint32_t capacity_ = 0;
     bool split_fills_ = false; // a round can hold more pairs than the features buffer
     vk::Buffer split_features_;

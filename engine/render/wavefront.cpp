@@ -384,7 +384,9 @@ void WavefrontRenderer::record_neural_rounds(vk::CommandBuffer& cmd, size_t trav
     const Dispatch all = shadow ? Dispatch::indirect_shadow : Dispatch::indirect_rays;
     const bool sort = record_ray_sort(cmd, q, depth, w, shadow); // op 0 reads the ray order
     record_pass(cmd, traverse_pass, constants(q, depth, w, sort ? NB_NL_MODE_SORTED : 0u), all);
-    const uint32_t batched = neural_->batched_rounds(shadow || depth > 0);
+    using RayClass = NeuralStage::RayClass;
+    const uint32_t batched =
+        neural_->batched_rounds(shadow ? RayClass::shadow : depth > 0 ? RayClass::path : RayClass::camera);
     for (uint32_t round = 0; round < batched; ++round) {
         const uint32_t half = round & 1u;
         record_pass(cmd, NEURAL_ARGS, constants(q, depth, w, 0), Dispatch::single);

@@ -138,12 +138,21 @@ void nb_traverse_neural_instance(uint instance) {
 uint nb_nl_op(uint mode) { return mode & 3u; }
 uint nb_nl_half(uint mode) { return (mode >> 2u) & 1u; }
 
-// The leaves a ray may query in all (g_nl_budget: camera rays neural_params.max_rounds, rays after the
-// first hit and shadow rays max_rounds_secondary, --neural-max-leaves-secondary) and per round
-// (g_nl_per_round: leaves_per_round_camera or leaves_per_round).
-void nb_nl_set_class(bool camera_ray) {
-    g_nl_budget = camera_ray ? neural_params.max_rounds : neural_params.max_rounds_secondary;
-    g_nl_per_round = camera_ray ? neural_params.leaves_per_round_camera : neural_params.leaves_per_round;
+// Ray classes of nb_nl_set_class: a camera ray, a ray after the first hit, a shadow ray.
+#define NB_NL_CAMERA 0u
+#define NB_NL_PATH 1u
+#define NB_NL_SHADOW 2u
+
+// The leaves a ray of class `ray_class` may query in all (g_nl_budget: camera rays
+// neural_params.max_rounds, rays after the first hit max_rounds_secondary, shadow rays
+// max_rounds_shadow) and per round (g_nl_per_round: camera rays leaves_per_round_camera, the others
+// leaves_per_round).
+void nb_nl_set_class(uint ray_class) {
+    g_nl_budget = ray_class == NB_NL_CAMERA ? neural_params.max_rounds
+                  : ray_class == NB_NL_PATH ? neural_params.max_rounds_secondary
+                                            : neural_params.max_rounds_shadow;
+    g_nl_per_round =
+        ray_class == NB_NL_CAMERA ? neural_params.leaves_per_round_camera : neural_params.leaves_per_round;
 }
 
 // Leaves a ray's next traversal looks for: the round size, within its leaf budget (g_nl_budget). Under
@@ -263,9 +272,18 @@ void nb_nl_finish_path(uint i, inout GpuNeuralRayState st) {
     }
 }
 
-// A shadow ray truncated by its leaf budget is occluded under --neural-truncated-shadows block (the
-// leaf left in front of it holds occupied cells along the ray: a candidate passed the occupancy walk).
-bool nb_nl_shadow_blocked() { return g_nl_truncated && g_nl_probe; }
+// Whether shadow ray `ray` (its index in the shadow queue), truncated by its leaf budget, is occluded:
+// with probability truncated_shadows_occlusion (--neural-truncated-shadows: block 1, pass 0, or P), drawn
+// from a hash of its pixel, sample and bounce (as its alpha-test seed, decorrelated), so that every pass
+// that decides it (neural_shadow's rounds, neural_tail) draws the same. The leaf left in front of the
+// ray holds occupied cells along it (a candidate passed the occupancy walk).
+bool nb_nl_truncated_shadow_occluded(uint ray) {
+    float p = neural_params.truncated_shadows_occlusion;
+    if (p >= 1.0f) return true;
+    uint seed = nb_shadow_alpha_seed(shadow_load1(NB_SHADOW_PIXEL, ray) & ~NB_RAY_BACKFACE_BIT);
+    return float(nb_pcg_hash(seed ^ 0x5bd1e995u) >> 8u) * (1.0f / 16777216.0f) < p;
+}
+bool nb_nl_shadow_blocked(uint ray) { return g_nl_truncated && g_nl_probe && nb_nl_truncated_shadow_occluded(ray); }
 
 GpuNeuralRayState nb_nl_fresh_state() {
     GpuNeuralRayState st;

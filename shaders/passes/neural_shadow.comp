@@ -18,8 +18,8 @@ void main() {
     uint op = nb_nl_op(pc.mode);
     uint half_ = nb_nl_half(pc.mode);
     uint cap = ray_capacity();
-    nb_nl_set_class(false);
-    g_nl_probe = neural_params.truncated_shadows_block != 0u;
+    nb_nl_set_class(NB_NL_SHADOW);
+    g_nl_probe = neural_params.truncated_shadows_occlusion > 0.0f;
     uint i;
     GpuNeuralRayState st;
     if (op == 1u) {
@@ -36,7 +36,7 @@ void main() {
         nb_nl_reduce_group(slot, nb_pair_group(pl.group), st);
         float tmax = uintBitsToFloat(shadow_load1(NB_SHADOW_TMAX, pl.ray - cap));
         // The leaf found beyond the budget in front of the ray's end: truncated, occluded by that leaf.
-        bool blocked = capped && nb_nl_may_have_more(st, tmax);
+        bool blocked = capped && nb_nl_may_have_more(st, tmax) && nb_nl_truncated_shadow_occluded(i);
         // An occluder found, no leaf left (also when the last key lies at or beyond the shadow ray's
         // end) or the budget spent: done without re-traversal.
         if (last || capped || st.best_t < NB_INF || !nb_nl_may_have_more(st, tmax)) {
@@ -74,7 +74,7 @@ void main() {
     if (!nb_nl_queue_candidate(cap + i, half_, tmax, org, dir, tmax, st)) {
         // No leaf in front of tmax: not occluded. A ray decided by its first traversal stores nothing
         // (op 1 and the tail read only the states of rays with queued pairs).
-        if (nb_nl_shadow_blocked()) nb_shadow_mark_occluded(i);
+        if (nb_nl_shadow_blocked(i)) nb_shadow_mark_occluded(i);
         if (op == 0u) return;
         st.status = NB_NRAY_DONE;
     }

@@ -37,8 +37,8 @@ void main() {
     g_alpha_seed = shadow ? nb_shadow_alpha_seed(shadow_load1(NB_SHADOW_PIXEL, i) & ~NB_RAY_BACKFACE_BIT)
                           : ray_load1(pc.in_queue, NB_RAY_RNG, i);
     uint lod = (shadow || pc.depth != 0u) ? neural_params.lod_secondary : neural_params.lod_primary;
-    nb_nl_set_class(!shadow && pc.depth == 0u);
-    g_nl_probe = shadow && neural_params.truncated_shadows_block != 0u;
+    nb_nl_set_class(shadow ? NB_NL_SHADOW : pc.depth == 0u ? NB_NL_CAMERA : NB_NL_PATH);
+    g_nl_probe = shadow && neural_params.truncated_shadows_occlusion > 0.0f;
     GpuNeuralRayState st = nb_state_load(ray);
     bool last = st.status == NB_NRAY_PENDING_LAST; // no leaf left behind this group
     bool capped = st.status == NB_NRAY_PENDING_CAP; // the budget spent, the leaf beyond it at key_t
@@ -75,7 +75,7 @@ void main() {
         if (!found) {
             if (shadow) {
                 st.status = NB_NRAY_DONE;
-                if (nb_nl_shadow_blocked()) nb_shadow_mark_occluded(i);
+                if (nb_nl_shadow_blocked(i)) nb_shadow_mark_occluded(i);
             } else {
                 nb_nl_finish_path(i, st);
             }

@@ -21,7 +21,7 @@ void main() {
     uint op = nb_nl_op(pc.mode);
     uint half_ = nb_nl_half(pc.mode);
     uint q = pc.in_queue;
-    nb_nl_set_class(pc.depth == 0u);
+    nb_nl_set_class(pc.depth == 0u ? NB_NL_CAMERA : NB_NL_PATH);
     uint i;
     GpuNeuralRayState st;
     if (op == 1u) {

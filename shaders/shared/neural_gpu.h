@@ -184,16 +184,23 @@ struct GpuNeuralParams {
     // dispatch fills the GPU about once, and the split pass's two dispatches then cost more than they
     // save (--neural-split-min-pairs). 0: every round starts with the split pass.
     uint split_min_pairs;
-    // Leaves queried per ray at most by rays after the first hit and by shadow rays (camera rays:
-    // max_rounds); <= max_rounds (--neural-max-leaves-secondary).
+    // Leaves queried per ray at most by rays after the first hit (camera rays: max_rounds; shadow rays:
+    // max_rounds_shadow); <= max_rounds (--neural-max-leaves-secondary).
     uint max_rounds_secondary;
-    // 1: a shadow ray truncated by its leaf budget is occluded (--neural-truncated-shadows block).
-    uint truncated_shadows_block;
+    // The probability that a shadow ray truncated by its leaf budget is occluded, in [0, 1]
+    // (--neural-truncated-shadows: block 1, pass 0; lib/neural_traverse.glsl nb_nl_shadow_blocked).
+    float truncated_shadows_occlusion;
     // 1..NB_NL_MAX_LEAVES_PER_ROUND leaves queued per traversal round by camera rays
     // (--neural-leaves-per-round-camera). The pending queue holds the larger of the two per ray.
     uint leaves_per_round_camera;
+    // Leaves queried per shadow ray at most, <= max_rounds (--neural-max-leaves-shadow; by default
+    // max_rounds_secondary): shadow rays' truncation leaks or blocks light, path rays' changes paths.
+    uint max_rounds_shadow;
+    uint pad0;
+    uint pad1;
+    uint pad2;
 };
-NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 96, "GpuNeuralParams layout");
+NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 112, "GpuNeuralParams layout");
 
 // A node's metallic and roughness in one word: unorm16 each, metallic in the low half (GLSL
 // unpackUnorm2x16 reads it back as vec2(metallic, roughness)).

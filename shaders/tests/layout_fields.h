@@ -115,7 +115,7 @@
     F(lod_secondary)                                                                                         \
     F(roughness) F(metallic) F(threshold) F(max_rounds) F(leaves_per_round) F(occupancy) F(materials)        \
         F(material_fits) F(material_spread) F(split_chunk) F(split_min_pairs) F(max_rounds_secondary)        \
-            F(truncated_shadows_block) F(leaves_per_round_camera)
+            F(truncated_shadows_occlusion) F(leaves_per_round_camera) F(max_rounds_shadow) F(pad0) F(pad1) F(pad2)
 #define NB_LAYOUT_FIELDS_GpuNeuralCounters(F)                                                                \
     F(pending_active)                                                                                        \
     F(queries_total)                                                                                         \

@@ -31,8 +31,8 @@ TEST(CliExplain, HybridRenderListsTheNeuralPasses) {
     EXPECT_TRUE(has(o, "MLP path        scalar")) << o;
     EXPECT_TRUE(has(o, "camera rays 1, after the first hit 0 (the model has 2")) << o;
     // the defaults
-    EXPECT_TRUE(has(o, "at most 8 (rays after the first hit and shadow rays 2), 1 queued per round (the "
-                       "others 2): 8 batched rounds (the others 1)"))
+    EXPECT_TRUE(has(o, "at most 8 (rays after the first hit 2, shadow rays 2), 1 queued per round (the "
+                       "others 2): 8 batched rounds (the others 1, shadow rays 1)"))
         << o;
     EXPECT_TRUE(has(o, "truncated rays  a shadow ray is occluded")) << o;
     EXPECT_TRUE(has(o, "occupancy masks on")) << o;
@@ -75,15 +75,15 @@ TEST(CliExplain, LeavesPerRoundComeFromTheRenderersStage) {
     // --neural-leaves-per-round reaches the renderer's stage (it was a hidden environment variable).
     const auto r = run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round", "3"}), 60.0);
     ASSERT_EQ(r.exit_code, 0) << r.describe();
-    EXPECT_TRUE(has(r.out, "at most 8 (rays after the first hit and shadow rays 2), 1 queued per round (the "
-                           "others 3): 8 batched rounds (the others 1)"))
+    EXPECT_TRUE(has(r.out, "at most 8 (rays after the first hit 2, shadow rays 2), 1 queued per round (the "
+                           "others 3): 8 batched rounds (the others 1, shadow rays 1)"))
         << r.out;
     // --neural-leaves-per-round-camera: the camera rays' rounds.
     const auto c =
         run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round-camera", "3"}), 60.0);
     ASSERT_EQ(c.exit_code, 0) << c.describe();
-    EXPECT_TRUE(has(c.out, "at most 8 (rays after the first hit and shadow rays 2), 3 queued per round (the "
-                           "others 2): 3 batched rounds (the others 1)"))
+    EXPECT_TRUE(has(c.out, "at most 8 (rays after the first hit 2, shadow rays 2), 3 queued per round (the "
+                           "others 2): 3 batched rounds (the others 1, shadow rays 1)"))
         << c.out;
     for (const char* bad : {"0", "5"}) {
         const auto e = run_nbvh(
@@ -96,11 +96,29 @@ TEST(CliExplain, LeavesPerRoundComeFromTheRenderersStage) {
                                      "--neural-max-leaves-secondary", "6"}),
                             60.0);
     ASSERT_EQ(s.exit_code, 0) << s.describe();
-    EXPECT_TRUE(has(s.out, "at most 3 (rays after the first hit and shadow rays 3)")) << s.out;
+    EXPECT_TRUE(has(s.out, "at most 3 (rays after the first hit 3, shadow rays 3)")) << s.out;
     const auto bad_secondary =
         run_nbvh(explain({"--model", tiny_model().string(), "--neural-max-leaves-secondary", "300"}), 60.0);
     EXPECT_EQ(check_clean_error(bad_secondary, {"--neural-max-leaves-secondary"}, false), "")
         << bad_secondary.describe();
+    // The shadow rays' own budget: apart from the path rays', never above the camera rays', its rounds.
+    const auto sh = run_nbvh(explain({"--model", tiny_model().string(), "--neural-max-leaves-secondary", "1",
+                                      "--neural-max-leaves-shadow", "5"}),
+                             60.0);
+    ASSERT_EQ(sh.exit_code, 0) << sh.describe();
+    EXPECT_TRUE(has(sh.out, "at most 8 (rays after the first hit 1, shadow rays 5), 1 queued per round (the "
+                            "others 2): 8 batched rounds (the others 1, shadow rays 3)"))
+        << sh.out;
+    const auto sh_cap = run_nbvh(explain({"--model", tiny_model().string(), "--neural-max-leaves", "3",
+                                          "--neural-max-leaves-shadow", "6"}),
+                                 60.0);
+    ASSERT_EQ(sh_cap.exit_code, 0) << sh_cap.describe();
+    EXPECT_TRUE(has(sh_cap.out, "at most 3 (rays after the first hit 2, shadow rays 3)")) << sh_cap.out;
+    for (const char* bad : {"300", "-1", "x"}) {
+        const auto e =
+            run_nbvh(explain({"--model", tiny_model().string(), "--neural-max-leaves-shadow", bad}), 60.0);
+        EXPECT_EQ(check_clean_error(e, {"--neural-max-leaves-shadow"}, false), "") << bad << "\n" << e.describe();
+    }
     // What a truncated shadow ray does, either way and a bad value.
     const auto block =
         run_nbvh(explain({"--model", tiny_model().string(), "--neural-truncated-shadows", "block"}), 60.0);
@@ -111,10 +129,16 @@ TEST(CliExplain, LeavesPerRoundComeFromTheRenderersStage) {
     ASSERT_EQ(pass.exit_code, 0) << pass.describe();
     EXPECT_TRUE(has(pass.out, "truncated rays  keep their closest hit, a shadow ray is unoccluded"))
         << pass.out;
-    const auto bad_shadows =
-        run_nbvh(explain({"--model", tiny_model().string(), "--neural-truncated-shadows", "maybe"}), 60.0);
-    EXPECT_EQ(check_clean_error(bad_shadows, {"--neural-truncated-shadows"}, false), "")
-        << bad_shadows.describe();
+    const auto quarter =
+        run_nbvh(explain({"--model", tiny_model().string(), "--neural-truncated-shadows", "0.25"}), 60.0);
+    ASSERT_EQ(quarter.exit_code, 0) << quarter.describe();
+    EXPECT_TRUE(has(quarter.out, "leaves out with probability 0.25")) << quarter.out;
+    for (const char* v : {"maybe", "1.5", "-0.1", "nan", "0.5x", ""}) {
+        const auto bad_shadows =
+            run_nbvh(explain({"--model", tiny_model().string(), "--neural-truncated-shadows", v}), 60.0);
+        EXPECT_EQ(check_clean_error(bad_shadows, {"--neural-truncated-shadows"}, false), "")
+            << v << "\n" << bad_shadows.describe();
+    }
     const auto bad = run_nbvh(explain({"--model", tiny_model().string(), "--neural-leaves-per-round", "9"}), 60.0);
     EXPECT_EQ(check_clean_error(bad, {"--neural-leaves-per-round"}, false), "") << bad.describe();
 }

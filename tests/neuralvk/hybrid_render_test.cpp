@@ -19,7 +19,7 @@
 #include "engine/scene/environment.h"
 #include "engine/scene/gltf_loader.h"
 #include "shaders/shared/neural_occupancy.h"
-#include "tests/neuralvk/trained_bunny.h"
+#include "tests/neuralvk/bunny_render.h"
 #include "tests/support/test_support.h"
 
 #include <gtest/gtest.h>
@@ -29,59 +29,11 @@
 
 using namespace nbvh;
 using namespace nbvh::render;
+using namespace nbvh::test;
 
 namespace {
 
 constexpr float FLIP_BOUND = 0.10f;
-
-using Fixture = test::TrainedBunny; // trained_bunny.h: trained once per executable
-using test::trained_bunny;
-
-struct Rendered {
-    Image image;
-    RenderStats stats;
-    int validation = 0;
-};
-
-using Tweak = std::function<void(RenderOptions&)>;
-
-// 64x64, 4 spp, 3 segments, the scalar MLP, the renderer's defaults otherwise; `tweak` changes options
-// after these (a hybrid render uses the fixture's model unless tweak sets another).
-Rendered render_bunny(const Fixture& f, bool hybrid, const Tweak& tweak = nullptr) {
-    vk::ContextOptions co;
-    co.device = vk::DeviceChoice::cpu;
-    co.validation = true;
-    vk::Context ctx(co);
-    const SceneAccel accel = build_scene_accel(f.scene);
-    Camera cam = auto_frame(f.scene, 1.0f);
-    cam.yfov *= 0.5f; // the bunny fills most of the frame, so FLIP means measure the asset, not the sky
-    RenderOptions o;
-    o.width = o.height = 64;
-    o.spp = 4;
-    o.max_depth = 3;
-    o.seed = 7;
-    o.neural.roughness = 0.6f;
-    o.neural.metallic = 0.0f;
-    o.neural.path = NeuralPath::scalar;
-    o.neural.secondary_lod = SECONDARY_LOD_SAME;
-    if (hybrid) o.neural.model = &f.model;
-    else o.neural.classical = true;
-    if (tweak) tweak(o);
-    WavefrontRenderer r(ctx, f.scene, accel, default_sky(), cam, o);
-    RenderResult res = r.render();
-    return {convert_channels(res.image, 3), res.stats, ctx.validation_message_count()};
-}
-
-// Batched rounds, leaves per round and the per-ray leaf budget (of every ray: the secondary budget 0).
-Tweak rounds(uint32_t batched, uint32_t leaves_per_round, uint32_t max_leaves = NeuralRenderOptions{}.max_rounds) {
-    return [=](RenderOptions& o) {
-        o.neural.batched_rounds = batched;
-        o.neural.leaves_per_round = leaves_per_round;
-        o.neural.leaves_per_round_camera = leaves_per_round;
-        o.neural.max_rounds = max_leaves;
-        o.neural.max_rounds_secondary = 0;
-    };
-}
 
 } // namespace
 
@@ -164,125 +116,6 @@ TEST(HybridRender, TailPassMatchesBatchedRounds) {
     EXPECT_EQ(all_batched.stats.neural_queries_by_depth, tail.stats.neural_queries_by_depth);
     EXPECT_GT(all_batched.stats.neural_queries_by_depth.at(0), 0u);
     EXPECT_GT(all_batched.stats.neural_queries_by_depth.at(1), 0u);
-}
-
-// The leaf-cap counter (RenderStats::neural_leaf_cap_rays) counts rays that spend their leaf budget (the
-// budget may cut them): with one leaf per ray every ray that queries a leaf; the same rays whether the
-// batched rounds or the tail pass query it; with a budget no ray reaches, none.
-TEST(HybridRender, LeafCapCounterCountsRaysAtTheirBudget) {
-    NBVH_REQUIRE_SHARED();
-    const Fixture& f = trained_bunny();
-    const Rendered cap1 = render_bunny(f, true, rounds(256, 1, 1));
-    const Rendered cap1_tail = render_bunny(f, true, rounds(0, 1, 1));
-    const Rendered cap256 = render_bunny(f, true, rounds(256, 4, 256));
-    EXPECT_EQ(cap1.validation + cap1_tail.validation + cap256.validation, 0);
-    std::printf("leaf-cap rays: budget 1: %llu (tail: %llu), budget 256: %llu of %llu rays\n",
-                (unsigned long long)cap1.stats.neural_leaf_cap_rays,
-                (unsigned long long)cap1_tail.stats.neural_leaf_cap_rays,
-                (unsigned long long)cap256.stats.neural_leaf_cap_rays, (unsigned long long)cap256.stats.rays_total());
-    EXPECT_GT(cap1.stats.neural_leaf_cap_rays, 0u);
-    EXPECT_EQ(cap1.stats.neural_leaf_cap_rays, cap1_tail.stats.neural_leaf_cap_rays);
-    EXPECT_EQ(cap1.stats.neural_queries, cap1_tail.stats.neural_queries);
-    EXPECT_EQ(cap256.stats.neural_leaf_cap_rays, 0u);
-    EXPECT_LT(cap1.stats.neural_leaf_cap_rays, cap1.stats.rays_total());
-}
-
-// Truncated shadow rays (--neural-truncated-shadows): blocking them only takes light away (no pixel
-// brighter, the mean darker) and changes no path (same queries, same rays counted at their budget). The
-// decision needs the leaf beyond the budget: found by the round that spends it (one leaf more looked
-// for), by the resumed traversal where a round of 4 leaves leaves no room, or by the tail pass: the same
-// decisions, so the same image.
-TEST(HybridRender, TruncatedShadowsPassOrBlock) {
-    NBVH_REQUIRE_SHARED();
-    const Fixture& f = trained_bunny();
-    auto truncate = [](uint32_t batched, uint32_t per_round, uint32_t secondary, bool block) {
-        return [=](RenderOptions& o) {
-            rounds(batched, per_round, 8)(o);
-            o.neural.max_rounds_secondary = secondary;
-            o.neural.truncated_shadows_block = block;
-        };
-    };
-    const Rendered pass = render_bunny(f, true, truncate(256, 1, 1, false));
-    const Rendered block = render_bunny(f, true, truncate(256, 1, 1, true));
-    const Rendered block_tail = render_bunny(f, true, truncate(0, 1, 1, true));
-    const Rendered block2 = render_bunny(f, true, truncate(256, 2, 4, true)); // looks one leaf further
-    const Rendered block4 = render_bunny(f, true, truncate(256, 4, 4, true)); // resumed once more
-    const Rendered pass4 = render_bunny(f, true, truncate(256, 4, 4, false));
-    EXPECT_EQ(pass.validation + block.validation + block_tail.validation + block2.validation +
-                  block4.validation + pass4.validation,
-              0);
-    auto mean = [](const Image& im) {
-        double m = 0.0;
-        for (float v : im.data) m += v;
-        return m / double(im.data.size());
-    };
-    const float f_tail = flip_hdr(block.image, block_tail.image).mean;
-    const float f_room = flip_hdr(block2.image, block4.image).mean;
-    std::printf(
-        "truncated shadow rays: image mean pass %.5f, block %.5f; rays at their budget %llu / %llu; FLIP "
-        "block vs its tail %.2e, 2 vs 4 leaves per round %.2e\n",
-        mean(pass.image), mean(block.image), (unsigned long long)pass.stats.neural_leaf_cap_rays,
-        (unsigned long long)block.stats.neural_leaf_cap_rays, f_tail, f_room);
-    ASSERT_EQ(block.image.data.size(), pass.image.data.size());
-    size_t brighter = 0;
-    for (size_t k = 0; k < pass.image.data.size(); ++k)
-        brighter += block.image.data[k] > pass.image.data[k] * (1.0f + 1e-5f) + 1e-6f ? 1u : 0u;
-    EXPECT_EQ(brighter, 0u);
-    EXPECT_LT(mean(block.image), mean(pass.image));
-    EXPECT_EQ(block.stats.neural_queries, pass.stats.neural_queries);
-    EXPECT_EQ(block.stats.neural_leaf_cap_rays, pass.stats.neural_leaf_cap_rays);
-    EXPECT_GT(block.stats.neural_leaf_cap_rays, 0u);
-    EXPECT_EQ(block.stats.nonfinite_pixels, 0u);
-    EXPECT_EQ(block_tail.stats.neural_leaf_cap_rays, block.stats.neural_leaf_cap_rays);
-    EXPECT_LT(f_tail, 1e-3f);
-    EXPECT_LT(f_room, 1e-3f);
-    // The resumed traversal (4 leaves per round) blocks some shadow rays too: the comparison above is
-    // not between two images without a blocked ray.
-    std::printf("budget 4, 4 leaves per round: image mean pass %.5f, block %.5f\n", mean(pass4.image),
-                mean(block4.image));
-    EXPECT_LT(mean(block4.image), mean(pass4.image));
-}
-
-// The secondary leaf budget (--neural-max-leaves-secondary) truncates rays after the first hit and shadow
-// rays only: the camera rays' budget (0) or its value gives the same image; budget 1 for them queries less
-// than the default and more than budget 1 for every ray, truncates fewer rays than the latter, and the tail
-// pass (which keeps the budgets per ray) takes the same decisions as the batched rounds.
-TEST(HybridRender, SecondaryLeafBudgetTruncatesLaterRaysOnly) {
-    NBVH_REQUIRE_SHARED();
-    const Fixture& f = trained_bunny();
-    auto secondary = [](uint32_t batched, uint32_t budget) {
-        return [=](RenderOptions& o) {
-            rounds(batched, 1, 8)(o);
-            o.neural.max_rounds_secondary = budget;
-        };
-    };
-    const Rendered base = render_bunny(f, true, secondary(256, 0));
-    const Rendered same = render_bunny(f, true, secondary(256, 8));
-    const Rendered sec1 = render_bunny(f, true, secondary(256, 1));
-    const Rendered sec1_tail = render_bunny(f, true, secondary(0, 1));
-    const Rendered all1 = render_bunny(f, true, rounds(256, 1, 1)); // the secondary budget then 1 too
-    const Rendered sec4 = render_bunny(f, true, secondary(256, 4)); // the default secondary budget before 2
-    EXPECT_EQ(base.validation + same.validation + sec1.validation + sec1_tail.validation + all1.validation +
-                  sec4.validation,
-              0);
-    std::printf("secondary budget: queries %llu (8) / %llu (secondary 1) / %llu (all 1); truncated rays %llu "
-                "/ %llu / %llu\n",
-                (unsigned long long)base.stats.neural_queries, (unsigned long long)sec1.stats.neural_queries,
-                (unsigned long long)all1.stats.neural_queries,
-                (unsigned long long)base.stats.neural_leaf_cap_rays,
-                (unsigned long long)sec1.stats.neural_leaf_cap_rays,
-                (unsigned long long)all1.stats.neural_leaf_cap_rays);
-    EXPECT_EQ(same.image.data, base.image.data);
-    EXPECT_EQ(same.stats.neural_queries, base.stats.neural_queries);
-    EXPECT_LT(sec1.stats.neural_queries, base.stats.neural_queries);
-    EXPECT_GT(sec1.stats.neural_queries, all1.stats.neural_queries);
-    EXPECT_GT(sec1.stats.neural_leaf_cap_rays, base.stats.neural_leaf_cap_rays);
-    EXPECT_LT(sec1.stats.neural_leaf_cap_rays, all1.stats.neural_leaf_cap_rays);
-    EXPECT_EQ(sec1_tail.stats.neural_queries, sec1.stats.neural_queries);
-    EXPECT_EQ(sec1_tail.stats.neural_leaf_cap_rays, sec1.stats.neural_leaf_cap_rays);
-    EXPECT_EQ(sec1.stats.nonfinite_pixels, 0u);
-    EXPECT_LE(sec4.stats.neural_queries, base.stats.neural_queries);
-    EXPECT_GT(sec4.stats.neural_queries, sec1.stats.neural_queries);
 }
 
 // Several leaves per ray per round (speculative queries of the next leaves in key order) pick the same
@@ -450,6 +283,14 @@ TEST(HybridRender, BadNeuralOptionsAreUserErrors) {
     o.max_rounds_secondary = 257;
     EXPECT_THROW(validate(o, f.scene), Error);
     o.max_rounds_secondary = 0;
+    o.max_rounds_shadow = 257;
+    EXPECT_THROW(validate(o, f.scene), Error);
+    o.max_rounds_shadow = 0;
+    o.truncated_shadows_occlusion = 1.5f;
+    EXPECT_THROW(validate(o, f.scene), Error);
+    o.truncated_shadows_occlusion = std::nanf("");
+    EXPECT_THROW(validate(o, f.scene), Error);
+    o.truncated_shadows_occlusion = 0.25f;
     o.leaves_per_round = 0;
     EXPECT_THROW(validate(o, f.scene), Error);
     o.leaves_per_round = NB_NL_MAX_LEAVES_PER_ROUND + 1;

@@ -463,7 +463,7 @@ TEST(MultiAsset, SettingsApplyWithoutRebuildMatchFreshRenderers) {
     deeper.neural.roughness = 0.2f;
     deeper.neural.max_rounds = 3;
     deeper.neural.max_rounds_secondary = 1;        // fewer leaves after the first hit
-    deeper.neural.truncated_shadows_block = false; // truncated shadow rays unoccluded: an upload too
+    deeper.neural.truncated_shadows_occlusion = 0.0f; // truncated shadow rays unoccluded: an upload too
     deeper.sampler = render::Sampler::random; // the sampler is an upload too
 
     WavefrontRenderer live(ctx, scene, accel, default_sky(), scene.camera, classical);
