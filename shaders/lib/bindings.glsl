@@ -67,7 +67,9 @@ layout(set = 0, binding = NB_BIND_PENDING_LEAVES_1, std430) buffer PendingLeafBu
 // The split query's passes (shared/neural_gpu.h NB_SPLIT_*) never touch the output image: their
 // descriptor sets bind the features buffer here instead (the layout has no binding to spare: lavapipe
 // allows 32 storage buffers per stage, and the split passes run only where cooperative matrices do).
+// Seen as quads (nb_split_index) and as 16-byte words (nb_split_tile_word: the tile rows).
 layout(set = 0, binding = NB_BIND_OUTPUT, std430) NB_SPLIT_FEATURES_ACCESS buffer SplitFeaturesBuffer { uvec2 split_features[]; };
+layout(set = 0, binding = NB_BIND_OUTPUT, std430) NB_SPLIT_FEATURES_ACCESS buffer SplitFeatureTiles { uvec4 split_feature_tiles[]; };
 #else
 layout(set = 0, binding = NB_BIND_OUTPUT, scalar) buffer OutputBuffer { vec4 output_pixels[]; };
 #endif

@@ -4,6 +4,7 @@
 layout(set = 0, binding = NB_NEVAL_BIND_MLP, std430) readonly buffer MlpBuffer { uvec4 neural_mlp_tiles[]; };
 #ifdef NB_SPLIT_FEATURES
 layout(set = 0, binding = NB_NEVAL_BIND_FEATURES, std430) readonly buffer FeatureBuffer { uvec2 split_features[]; };
+layout(set = 0, binding = NB_NEVAL_BIND_FEATURES, std430) readonly buffer FeatureTiles { uvec4 split_feature_tiles[]; };
 #endif
 #include "lib/neural_grid.glsl"
 #include "lib/neural_mlp_coopmat.glsl"
@@ -22,23 +23,33 @@ void main() {
     GpuNeuralQuery q = nb_eval_query(i, valid);
     vec3 p0, p1, p2;
     nb_segment_points(pc.box, q.origin, q.dir, q.t_entry, q.t_exit, p0, p1, p2);
-    if (NB_EVAL_PART == 2u) {
-        for (uint f = 0u; f < NB_MLP_INPUTS; f += 4u) {
-            vec4 v;
-            for (uint c = 0u; c < 4u; ++c) v[c] = float(((i * 7u + f + c) & 15u)) * (1.0f / 16.0f) + p0.x;
-            nb_coop_x_write4(local, f, v); // packing rounds to fp16
-        }
-    } else {
 #ifdef NB_SPLIT_FEATURES
-        nb_coop_stage_split_features(local, valid, i);
+    // The full split query: the MLP's first layer reads the features straight from the buffer (as
+    // passes/neural_query_mlp32.comp); the breakdown parts stage them.
+    if (NB_EVAL_PART == 0u) {
+        nb_mlp_forward_coopmat_split(); // whole workgroup, uniform control flow (a specialisation constant)
+    } else {
 #else
-        nb_coop_stage_features(local, valid, p0, p1, p2);
+    {
 #endif
+        if (NB_EVAL_PART == 2u) {
+            for (uint f = 0u; f < NB_MLP_INPUTS; f += 4u) {
+                vec4 v;
+                for (uint c = 0u; c < 4u; ++c) v[c] = float(((i * 7u + f + c) & 15u)) * (1.0f / 16.0f) + p0.x;
+                nb_coop_x_write4(local, f, v); // packing rounds to fp16
+            }
+        } else {
+#ifdef NB_SPLIT_FEATURES
+            nb_coop_stage_split_features(local, valid, i);
+#else
+            nb_coop_stage_features(local, valid, p0, p1, p2);
+#endif
+        }
+        // Each subgroup stages and runs the MLP on only its own 32 rows: with NB_COOP_FAST a subgroup
+        // barrier (shared-memory semantics) lets one subgroup's MLP overlap the other's gather.
+        NB_COOP_SYNC();
+        if (NB_EVAL_PART != 1u) nb_mlp_forward_coopmat(); // whole workgroup, uniform control flow
     }
-    // Each subgroup stages and runs the MLP on only its own 32 rows: with NB_COOP_FAST a subgroup
-    // barrier (shared-memory semantics) lets one subgroup's MLP overlap the other's gather.
-    NB_COOP_SYNC();
-    if (NB_EVAL_PART != 1u) nb_mlp_forward_coopmat(); // whole workgroup, uniform control flow
     if (!valid) return;
     float y[NB_MLP_OUTPUTS];
     for (uint r = 0u; r < NB_MLP_OUTPUTS; ++r) {

@@ -1,10 +1,10 @@
 // Body of passes/neural_eval_gather.comp, the flat-list form of the split query's gather pass
 // (passes/neural_gather.comp): the hash-grid features of each query's 3 segment points, written as 24
-// fp16 quads (point-major, then level) to the features buffer at nb_split_index (shared/neural_gpu.h);
+// fp16 quads (point-major, then level) to the features buffer as its tile rows (shared/neural_gpu.h);
 // passes/neural_eval_mlp32.comp runs the MLP on them. For the benchmark and tests.
 #define NB_COOP_ACC_BITS 32 // the paired-lane gather of lib/neural_grid.glsl
 #include "lib/neural_eval_common.glsl"
-layout(set = 0, binding = NB_NEVAL_BIND_FEATURES, std430) writeonly buffer FeatureBuffer { uvec2 split_features[]; };
+layout(set = 0, binding = NB_NEVAL_BIND_FEATURES, std430) writeonly buffer FeatureTiles { uvec4 split_feature_tiles[]; };
 #include "lib/neural_grid.glsl"
 
 layout(local_size_x = NB_NEURAL_GROUP) in;
@@ -15,5 +15,5 @@ void main() {
     GpuNeuralQuery q = nb_eval_query(i, valid);
     vec3 p0, p1, p2;
     nb_segment_points(pc.box, q.origin, q.dir, q.t_entry, q.t_exit, p0, p1, p2);
-    NB_PAIRED_GATHER_SEGMENT(p0, p1, p2, if (valid) split_features[nb_split_index(i, k * NB_GRID_MAX_LEVELS + l)] = nb_split_quad(f);)
+    NB_SPLIT_GATHER_STORE(i, valid, p0, p1, p2)
 }

@@ -103,6 +103,21 @@ void nb_neural_levels_paired(vec3 p_even, vec3 p_odd, uint l0, uint xbit, out ve
 // A level's 4 features (already fp16 values) as one 8-byte quad of the split query's features buffer.
 uvec2 nb_split_quad(vec4 f) { return uvec2(packHalf2x16(f.xy), packHalf2x16(f.zw)); }
 
+// The split query's gather (passes/neural_gather.comp, neural_eval_gather.comp): pair K's features of
+// points P0..P2 into the features buffer (`uvec4 split_feature_tiles[]`, shared/neural_gpu.h
+// nb_split_tile_word), one tile row (4 levels of a point: NB_GATHER_LEVELS must be 4) as two 16-byte
+// stores; only where VALID (q_ is indexed by the unrolled level of the batch, g_, never dynamically).
+// All 32 lanes must be active.
+#define NB_SPLIT_GATHER_STORE(K, VALID, P0, P1, P2)                                                   \
+    {                                                                                                 \
+        uvec2 q_[NB_GATHER_LEVELS == 4u ? 4 : -1]; /* a tile row per batch: NB_GATHER_LEVELS must be 4 */ \
+        NB_PAIRED_GATHER_SEGMENT(P0, P1, P2, q_[g_] = nb_split_quad(f); if (g_ == 3u && (VALID)) {      \
+            uint w_ = nb_split_tile_word((K), (k * NB_GRID_MAX_LEVELS + l) / 4u);                    \
+            split_feature_tiles[w_] = uvec4(q_[0], q_[1]);                                            \
+            split_feature_tiles[w_ + 1u] = uvec4(q_[2], q_[3]);                                       \
+        })                                                                                            \
+    }
+
 // Runs BODY for every (point k, level l) of a segment's 3 points with `vec4 f` = that level's 4
 // features (fp16-rounded), through the paired-lane gather, NB_GATHER_LEVELS levels of a point at a
 // time (the fused query kernels stage f in shared memory, the split query's gather pass stores it).

@@ -93,15 +93,28 @@ float nb_coop_x_read(uint row, uint f) {
 
 #define NB_FCM(BITS) fcoopmatNV<BITS, gl_ScopeSubgroup, 16, 16>
 
-// ACC[0..7] = X[:, 0:K] * W_m^T for the 32 rows of this subgroup, the A tiles loaded from nb_sh_x:
+// A tile (rows ROW..ROW+15, features KT*16..+15) of the layer input staged in nb_sh_x.
+#define NB_COOP_LOAD_A_SHARED(A, ROW, KT) \
+    coopMatLoadNV(A, nb_sh_x, (ROW) * NB_COOP_STRIDE_V + (KT) * 2u, NB_COOP_STRIDE_V, false)
+#ifdef NB_SPLIT_FEATURES
+// ... of the features in the split query's features buffer (shared/neural_gpu.h nb_split_tile_word: the
+// workgroup's pairs gl_WorkGroupID.x * NB_NEURAL_GROUP + row; the includer declares `uvec4
+// split_feature_tiles[]`), straight from global memory. Rows of invalid pairs hold stale or unwritten
+// features: a row's products depend on that row alone, and its outputs are not used.
+#define NB_COOP_LOAD_A_SPLIT(A, ROW, KT)                                                              \
+    coopMatLoadNV(A, split_feature_tiles, nb_split_tile_word(gl_WorkGroupID.x * NB_NEURAL_GROUP + (ROW), (KT)), \
+                  NB_SPLIT_TILE_ROW_WORDS, false)
+#endif
+
+// ACC[0..7] = X[:, 0:K] * W_m^T for the 32 rows of this subgroup, the A tiles loaded by LOAD_A:
 // ACC[nt] = rows row0..+15, output columns nt*16..+15; ACC[4 + nt] = rows row0+16..+31.
-#define NB_COOP_ACC_FROM_SHARED(ACC, K, WOFF)                                                         \
+#define NB_COOP_ACC_FROM(ACC, K, WOFF, LOAD_A)                                                        \
     NB_UNROLL for (uint j = 0u; j < 8u; ++j) ACC[j] = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));        \
     NB_UNROLL for (uint kt = 0u; kt < (K) / 16u; ++kt) {                                              \
         NB_FCM(16) a0;                                                                                \
         NB_FCM(16) a1;                                                                                \
-        coopMatLoadNV(a0, nb_sh_x, row0 * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false);       \
-        coopMatLoadNV(a1, nb_sh_x, (row0 + 16u) * NB_COOP_STRIDE_V + kt * 2u, NB_COOP_STRIDE_V, false); \
+        LOAD_A(a0, row0, kt);                                                                         \
+        LOAD_A(a1, row0 + 16u, kt);                                                                   \
         NB_UNROLL for (uint nt = 0u; nt < 4u; ++nt) {                                                 \
             NB_FCM(16) b;                                                                             \
             coopMatLoadNV(b, neural_mlp_tiles, ((WOFF) + nb_coop_weight_slot(NB_MLP_WIDTH, kt * 16u, nt * 16u)) / 8u, 2u, false); \
@@ -130,11 +143,11 @@ float nb_coop_x_read(uint row, uint f) {
 // nt*16..+15 and H[4 + nt] = rows row0+16..+31: each layer's output tiles are the next layer's A
 // operands. The same products and fp32 sums, in the same order, as the in-place form below.
 
-// Layer 0 (K = 96, A tiles from the staged features) into H.
-#define NB_COOP_LAYER0_REGS(H)                                                                        \
+// Layer 0 (K = 96, A tiles from LOAD_A: the staged features or the split query's buffer) into H.
+#define NB_COOP_LAYER0_REGS(H, LOAD_A)                                                                \
     {                                                                                                 \
         NB_FCM(NB_COOP_ACC_BITS) acc[8];                                                              \
-        NB_COOP_ACC_FROM_SHARED(acc, NB_MLP_INPUTS, nb_mlp_layer_offset(0u))                          \
+        NB_COOP_ACC_FROM(acc, NB_MLP_INPUTS, nb_mlp_layer_offset(0u), LOAD_A)                         \
         NB_UNROLL for (uint j = 0u; j < 8u; ++j) {                                                    \
             NB_UNROLL for (int e = 0; e < acc[j].length(); ++e) acc[j][e] = max(acc[j][e], NB_ACC_T(0.0)); \
             H[j] = NB_FCM(16)(acc[j]);                                                                \
@@ -164,31 +177,39 @@ float nb_coop_x_read(uint row, uint f) {
         NB_UNROLL for (uint j = 0u; j < 8u; ++j) H[j] = o[j];                                         \
     }
 
-void nb_mlp_forward_coopmat() {
-    uint row0 = (gl_LocalInvocationID.x / NB_COOP_ROWS) * NB_COOP_ROWS;
-    NB_FCM(16) h[8];
-    NB_COOP_LAYER0_REGS(h)
-    NB_COOP_HIDDEN_REGS(h, 1u)
-    NB_COOP_HIDDEN_REGS(h, 2u)
-    NB_COOP_HIDDEN_REGS(h, 3u)
-    NB_FCM(NB_COOP_ACC_BITS) acc0 = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));
-    NB_FCM(NB_COOP_ACC_BITS) acc1 = acc0;
-    NB_UNROLL for (uint kt = 0u; kt < NB_MLP_WIDTH / 16u; ++kt) {
-        NB_FCM(16) b;
-        NB_COOP_LOAD_OUTPUT_B(b, kt);
-        acc0 = coopMatMulAddNV(h[kt], b, acc0);
-        acc1 = coopMatMulAddNV(h[4u + kt], b, acc1);
-    }
-    NB_COOP_STORE_OUTPUTS(acc0, acc1)
+// The whole MLP of the subgroup's 32 rows, layer 0's A tiles from LOAD_A (a macro, not a function
+// taking the register matrices: no cooperative-matrix arrays passed or indexed at run time).
+#define NB_COOP_FORWARD_REGS(LOAD_A)                                                                  \
+    uint row0 = (gl_LocalInvocationID.x / NB_COOP_ROWS) * NB_COOP_ROWS;                               \
+    NB_FCM(16) h[8];                                                                                  \
+    NB_COOP_LAYER0_REGS(h, LOAD_A)                                                                    \
+    NB_COOP_HIDDEN_REGS(h, 1u)                                                                        \
+    NB_COOP_HIDDEN_REGS(h, 2u)                                                                        \
+    NB_COOP_HIDDEN_REGS(h, 3u)                                                                        \
+    NB_FCM(NB_COOP_ACC_BITS) acc0 = NB_FCM(NB_COOP_ACC_BITS)(NB_ACC_T(0.0));                          \
+    NB_FCM(NB_COOP_ACC_BITS) acc1 = acc0;                                                             \
+    NB_UNROLL for (uint kt = 0u; kt < NB_MLP_WIDTH / 16u; ++kt) {                                     \
+        NB_FCM(16) b;                                                                                 \
+        NB_COOP_LOAD_OUTPUT_B(b, kt);                                                                 \
+        acc0 = coopMatMulAddNV(h[kt], b, acc0);                                                       \
+        acc1 = coopMatMulAddNV(h[4u + kt], b, acc1);                                                  \
+    }                                                                                                 \
+    NB_COOP_STORE_OUTPUTS(acc0, acc1)                                                                 \
     NB_COOP_SYNC();
-}
+
+void nb_mlp_forward_coopmat() { NB_COOP_FORWARD_REGS(NB_COOP_LOAD_A_SHARED) }
+#ifdef NB_SPLIT_FEATURES
+// The split query's MLP: the features read by the tensor cores straight from the features buffer
+// (nothing staged in nb_sh_x; the outputs still go to nb_sh_y).
+void nb_mlp_forward_coopmat_split() { NB_COOP_FORWARD_REGS(NB_COOP_LOAD_A_SPLIT) }
+#endif
 #else
 // One hidden layer in place in nb_sh_x: X[:, 0:64] = half(relu(X[:, 0:K] * W_m^T)) (all of its input
 // tiles are loaded before a barrier, then the outputs stored).
 #define NB_COOP_HIDDEN_LAYER(K, WOFF)                                                                 \
     {                                                                                                 \
         NB_FCM(NB_COOP_ACC_BITS) acc[8];                                                              \
-        NB_COOP_ACC_FROM_SHARED(acc, K, WOFF)                                                         \
+        NB_COOP_ACC_FROM(acc, K, WOFF, NB_COOP_LOAD_A_SHARED)                                         \
         NB_COOP_SYNC();                                                                               \
         NB_UNROLL for (uint j = 0u; j < 8u; ++j) {                                                    \
             NB_UNROLL for (int e = 0; e < acc[j].length(); ++e) acc[j][e] = max(acc[j][e], NB_ACC_T(0.0)); \

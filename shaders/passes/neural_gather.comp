@@ -19,5 +19,5 @@ void main() {
     vec3 p0, p1, p2;
     nb_segment_points(neural_params.box, r.org, r.dir, r.pl.t_enter, r.pl.t_exit, p0, p1, p2);
     // Every lane gathers (the lane pairs shuffle), only valid pairs store.
-    NB_PAIRED_GATHER_SEGMENT(p0, p1, p2, if (r.valid) split_features[nb_split_index(pair, k * NB_GRID_MAX_LEVELS + l)] = nb_split_quad(f);)
+    NB_SPLIT_GATHER_STORE(pair, r.valid, p0, p1, p2)
 }

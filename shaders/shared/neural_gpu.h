@@ -228,7 +228,7 @@ NB_FN vec2 nb_node_fit_spread(vec2 fit, vec2 spread, uint random_bits) {
 
 // The split query pass (engine/render/neural_stage.h NeuralRenderOptions::split_query): a gather pass
 // (passes/neural_gather.comp) writes each pair's 96 features as NB_SPLIT_FEATURE_QUADS fp16 quads to a
-// features buffer (nb_split_index: blocks of NB_NEURAL_GROUP pairs, quad-major inside a block), then an MLP
+// features buffer (nb_split_index: blocks of NB_NEURAL_GROUP pairs, tile-major inside a block), then an MLP
 // pass (passes/neural_query_mlp32.comp) reads them. The buffer holds split_chunk pairs (one binding);
 // a round with more pairs than that (a pending half can hold more) gives the rest to the fused query
 // pass, dispatched after them with NB_QUERY_MODE_OVERFLOW (its pairs start at
@@ -237,14 +237,22 @@ NB_FN vec2 nb_node_fit_spread(vec2 fit, vec2 spread, uint random_bits) {
 #define NB_SPLIT_FEATURE_QUADS 24u // NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS, 8 bytes each
 #define NB_QUERY_MODE_OVERFLOW 16u // pass-constant mode bit of the fused query pass (bits 0-3: neural_traverse.glsl)
 
-// Quad s of the round's pair k (k < split_chunk) in the features buffer, in quads: each workgroup's NB_NEURAL_GROUP
-// pairs own one contiguous block (12 KiB), quad-major inside it, so a subgroup's stores and loads of a
-// quad are 256 contiguous bytes and a pair's 24 quads lie in one block. (Quad-major over the whole
-// buffer put a pair's quads 174 MB apart in a 4 GB buffer.)
-NB_FN uint nb_split_index(uint k, uint s) {
-    return (k / NB_NEURAL_GROUP) * (NB_NEURAL_GROUP * NB_SPLIT_FEATURE_QUADS) + s * NB_NEURAL_GROUP +
-           k % NB_NEURAL_GROUP;
+// The features buffer: each workgroup's NB_NEURAL_GROUP pairs own one contiguous block (12 KiB, so a
+// pair's features lie in one block; quad-major over the whole buffer put a pair's quads 174 MB apart in
+// a 4 GB buffer), and inside it the 96 features are NB_SPLIT_TILES tiles of 16 (a point's 4 levels, 4
+// quads), each a row-major NB_NEURAL_GROUP x 16 fp16 matrix (2 KiB): the MLP pass loads its first
+// layer's A operands (16 pairs x 16 features, 512 contiguous bytes) straight from the buffer with
+// cooperative-matrix loads, no staging in shared memory, and the gather pass stores a pair's tile row
+// (32 bytes) at once, a subgroup's stores 1 KiB contiguous.
+#define NB_SPLIT_TILES 6u        // NB_SPLIT_FEATURE_QUADS / 4
+#define NB_SPLIT_TILE_ROW_WORDS 2u // 16-byte words per pair and tile (16 fp16 features)
+// 16-byte word of pair k's row of tile t (its features 16t..16t+15; quads 4t..4t+3).
+NB_FN uint nb_split_tile_word(uint k, uint t) {
+    return (k / NB_NEURAL_GROUP) * (NB_NEURAL_GROUP * NB_SPLIT_FEATURE_QUADS / 2u) +
+           t * (NB_NEURAL_GROUP * NB_SPLIT_TILE_ROW_WORDS) + (k % NB_NEURAL_GROUP) * NB_SPLIT_TILE_ROW_WORDS;
 }
+// Quad s (features 4s..4s+3) of the round's pair k (k < split_chunk) in the features buffer, in quads.
+NB_FN uint nb_split_index(uint k, uint s) { return 2u * nb_split_tile_word(k, s / 4u) + (s & 3u); }
 
 struct GpuNeuralCounters {
     uint pending_active;  // pairs the current neural_query dispatch processes

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <vector>
 
 #include "engine/neural/model_file.h"
 #include "engine/render/neural_stage.h"
@@ -103,11 +104,14 @@ TEST(WavePlan, AMemoryShareBoundsTheWave) {
         EXPECT_EQ(p.samples, share == 0.09f ? 28u : 16u) << share;
         EXPECT_LE(uint64_t(p.capacity) * wave_bytes_per_path(o), uint64_t(80.0 * double(GIB) * share));
     }
-    const WavePlan classical = plan_wave(960ull * 540, [] {
-        RenderOptions o = opts(512);
-        o.wave_memory_share = 0.1f;
-        return o;
-    }(), h100());
+    const WavePlan classical = plan_wave(
+        960ull * 540,
+        [] {
+            RenderOptions o = opts(512);
+            o.wave_memory_share = 0.1f;
+            return o;
+        }(),
+        h100());
     EXPECT_EQ(classical.samples, 32u); // 196 bytes a path: 43.8M paths fit, the 32-sample bound holds
 }
 
@@ -182,14 +186,18 @@ TEST(WavePlan, DeepPathsKeepTheRayCountersFromWrapping) {
 TEST(WavePlan, RandomOptionsAndLimitsStayWithinEveryBound) {
     const NeuralModel model;
     std::mt19937_64 rng(7);
-    auto pick = [&](uint64_t lo, uint64_t hi) { return std::uniform_int_distribution<uint64_t>(lo, hi)(rng); };
+    auto pick = [&](uint64_t lo, uint64_t hi) {
+        return std::uniform_int_distribution<uint64_t>(lo, hi)(rng);
+    };
     for (int i = 0; i < 20000; ++i) {
         const uint64_t pixels = pick(0, 3) == 0 ? pick(1, 64) : pick(1, 16384ull * 16384);
-        RenderOptions o = opts(uint32_t(pick(1, 4096)), pick(0, 1) ? &model : nullptr, uint32_t(pick(1, NB_NL_MAX_LEAVES_PER_ROUND)));
+        RenderOptions o = opts(uint32_t(pick(1, 4096)), pick(0, 1) ? &model : nullptr,
+                               uint32_t(pick(1, NB_NL_MAX_LEAVES_PER_ROUND)));
         o.max_depth = uint32_t(pick(1, 256));
         o.neural.max_rounds = uint32_t(pick(1, 256));
         o.max_wave_pixels = uint32_t(pick(64, 1u << 26));
-        const WaveLimits l{pick(16 * MIB, 8 * GIB), pick(0, 1) ? pick(256 * MIB, 192 * GIB) : 0, uint32_t(pick(0, 0x7FFFFFFF))};
+        const WaveLimits l{pick(16 * MIB, 8 * GIB), pick(0, 1) ? pick(256 * MIB, 192 * GIB) : 0,
+                           uint32_t(pick(0, 0x7FFFFFFF))};
         const WavePlan p = plan_wave(pixels, o, l);
         expect_within_limits(pixels, o, l, p);
         if (HasFatalFailure() || HasNonfatalFailure()) break;
@@ -281,10 +289,45 @@ TEST(SplitQueryPlan, TakesAPendingHalfWithinOneBuffer) {
     }
     // 16 samples of 1080p at 2 leaves per round: 66M pairs, 21.8M of them in 4 GiB of features (the fused
     // pass takes the rest of a round, which no default render at that size reaches).
-    EXPECT_EQ(plan_split_query(2ull * 33177600ull, nvidia), nvidia / quad_bytes / NB_NEURAL_GROUP * NB_NEURAL_GROUP);
+    EXPECT_EQ(plan_split_query(2ull * 33177600ull, nvidia),
+              nvidia / quad_bytes / NB_NEURAL_GROUP * NB_NEURAL_GROUP);
     EXPECT_EQ(plan_split_query(65, nvidia), 128u); // a small half: all of it, rounded up to a workgroup
     EXPECT_EQ(plan_split_query(1ull << 24, 128ull << 20), 699008u); // lavapipe's 128 MiB bound
     EXPECT_EQ(plan_split_query(49152, nvidia, 12800), 12800u);
     EXPECT_EQ(plan_split_query(100, nvidia, 10), 0u); // not one workgroup: the fused pass
     EXPECT_EQ(plan_split_query(100, 1000), 0u);
+}
+
+// The split query's features buffer (shared/neural_gpu.h nb_split_index, nb_split_tile_word): every
+// (pair, quad) has its own slot, a pair's quads lie in its workgroup's block, and inside a block each
+// tile of 16 features is a row-major NB_NEURAL_GROUP x 16 fp16 matrix, so that 16 consecutive pairs'
+// rows of a tile are the 512 contiguous bytes one cooperative-matrix load of the MLP pass reads (row
+// stride NB_SPLIT_TILE_ROW_WORDS 16-byte words), and the gather pass's two 16-byte stores per tile row
+// hold that row's 4 quads in order.
+TEST(SplitQueryPlan, FeaturesAreTileRowsOfEachWorkgroup) {
+    const uint32_t groups = 3, pairs = groups * NB_NEURAL_GROUP, quads = pairs * NB_SPLIT_FEATURE_QUADS;
+    ASSERT_EQ(NB_SPLIT_TILES * 4u, NB_SPLIT_FEATURE_QUADS);
+    std::vector<int> seen(quads, 0);
+    for (uint32_t k = 0; k < pairs; ++k) {
+        const uint32_t block = k / NB_NEURAL_GROUP * NB_NEURAL_GROUP * NB_SPLIT_FEATURE_QUADS;
+        for (uint32_t s = 0; s < NB_SPLIT_FEATURE_QUADS; ++s) {
+            const uint32_t q = nb_split_index(k, s);
+            ASSERT_LT(q, quads);
+            ++seen[q];
+            EXPECT_GE(q, block);
+            EXPECT_LT(q, block + NB_NEURAL_GROUP * NB_SPLIT_FEATURE_QUADS);
+            // The tile row's word (16 bytes = 2 quads) and the quad's place in it.
+            EXPECT_EQ(q, 2u * nb_split_tile_word(k, s / 4u) + s % 4u) << k << " " << s;
+        }
+    }
+    for (uint32_t q = 0; q < quads; ++q) EXPECT_EQ(seen[q], 1) << q;
+    for (uint32_t g = 0; g < groups; ++g)
+        for (uint32_t t = 0; t < NB_SPLIT_TILES; ++t)
+            for (uint32_t r0 = 0; r0 < NB_NEURAL_GROUP; r0 += 16) {
+                const uint32_t k0 = g * NB_NEURAL_GROUP + r0, w0 = nb_split_tile_word(k0, t);
+                EXPECT_EQ(w0 % 2u, 0u); // 32-byte aligned tile rows
+                for (uint32_t r = 0; r < 16; ++r)
+                    EXPECT_EQ(nb_split_tile_word(k0 + r, t), w0 + r * NB_SPLIT_TILE_ROW_WORDS)
+                        << g << " " << t << " " << r;
+            }
 }
