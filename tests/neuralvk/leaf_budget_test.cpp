@@ -13,6 +13,23 @@ using namespace nbvh;
 using namespace nbvh::render;
 using namespace nbvh::test;
 
+namespace {
+
+// Two renders that queried the same leaves and counted the same rays at their budget (the batched
+// rounds and the tail pass taking the same decisions, or two renders whose paths are the same).
+void expect_same_rays(const Rendered& a, const Rendered& b, const char* what) {
+    EXPECT_EQ(a.stats.neural_queries, b.stats.neural_queries) << what;
+    EXPECT_EQ(a.stats.neural_leaf_cap_rays, b.stats.neural_leaf_cap_rays) << what;
+}
+
+// ... and the same image to the bit.
+void expect_same_render(const Rendered& a, const Rendered& b, const char* what) {
+    EXPECT_EQ(a.image.data, b.image.data) << what;
+    expect_same_rays(a, b, what);
+}
+
+} // namespace
+
 // The leaf-cap counter (RenderStats::neural_leaf_cap_rays) counts rays that spend their leaf budget (the
 // budget may cut them): with one leaf per ray every ray that queries a leaf; the same rays whether the
 // batched rounds or the tail pass query it; with a budget no ray reaches, none.
@@ -29,8 +46,7 @@ TEST(HybridRender, LeafCapCounterCountsRaysAtTheirBudget) {
                 (unsigned long long)cap256.stats.neural_leaf_cap_rays,
                 (unsigned long long)cap256.stats.rays_total());
     EXPECT_GT(cap1.stats.neural_leaf_cap_rays, 0u);
-    EXPECT_EQ(cap1.stats.neural_leaf_cap_rays, cap1_tail.stats.neural_leaf_cap_rays);
-    EXPECT_EQ(cap1.stats.neural_queries, cap1_tail.stats.neural_queries);
+    expect_same_rays(cap1, cap1_tail, "budget 1: batched vs tail");
     EXPECT_EQ(cap256.stats.neural_leaf_cap_rays, 0u);
     EXPECT_LT(cap1.stats.neural_leaf_cap_rays, cap1.stats.rays_total());
 }
@@ -74,8 +90,7 @@ TEST(HybridRender, TruncatedShadowsPassOrBlock) {
         brighter += block.image.data[k] > pass.image.data[k] * (1.0f + 1e-5f) + 1e-6f ? 1u : 0u;
     EXPECT_EQ(brighter, 0u);
     EXPECT_LT(image_mean(block.image), image_mean(pass.image));
-    EXPECT_EQ(block.stats.neural_queries, pass.stats.neural_queries);
-    EXPECT_EQ(block.stats.neural_leaf_cap_rays, pass.stats.neural_leaf_cap_rays);
+    expect_same_rays(block, pass, "block vs pass");
     EXPECT_GT(block.stats.neural_leaf_cap_rays, 0u);
     EXPECT_EQ(block.stats.nonfinite_pixels, 0u);
     EXPECT_EQ(block_tail.stats.neural_leaf_cap_rays, block.stats.neural_leaf_cap_rays);
@@ -133,14 +148,12 @@ TEST(HybridRender, SecondaryLeafBudgetTruncatesLaterRaysOnly) {
                 (unsigned long long)base.stats.neural_leaf_cap_rays,
                 (unsigned long long)sec1.stats.neural_leaf_cap_rays,
                 (unsigned long long)all1.stats.neural_leaf_cap_rays);
-    EXPECT_EQ(same.image.data, base.image.data);
-    EXPECT_EQ(same.stats.neural_queries, base.stats.neural_queries);
+    expect_same_render(same, base, "secondary budget 8 vs 0");
     EXPECT_LT(sec1.stats.neural_queries, base.stats.neural_queries);
     EXPECT_GT(sec1.stats.neural_queries, all1.stats.neural_queries);
     EXPECT_GT(sec1.stats.neural_leaf_cap_rays, base.stats.neural_leaf_cap_rays);
     EXPECT_LT(sec1.stats.neural_leaf_cap_rays, all1.stats.neural_leaf_cap_rays);
-    EXPECT_EQ(sec1_tail.stats.neural_queries, sec1.stats.neural_queries);
-    EXPECT_EQ(sec1_tail.stats.neural_leaf_cap_rays, sec1.stats.neural_leaf_cap_rays);
+    expect_same_rays(sec1_tail, sec1, "secondary 1: tail vs batched");
     EXPECT_EQ(sec1.stats.nonfinite_pixels, 0u);
     EXPECT_LE(sec4.stats.neural_queries, base.stats.neural_queries);
     EXPECT_GT(sec4.stats.neural_queries, sec1.stats.neural_queries);
@@ -178,13 +191,11 @@ TEST(HybridRender, ShadowLeafBudgetIsTheShadowRaysOwn) {
                 (unsigned long long)p1.stats.neural_leaf_cap_rays,
                 (unsigned long long)p1s8.stats.neural_leaf_cap_rays, image_mean(p8s1.image),
                 image_mean(p8s1_block.image));
-    EXPECT_EQ(p1s1.image.data, p1.image.data);
-    EXPECT_EQ(p1s1.stats.neural_queries, p1.stats.neural_queries);
+    expect_same_render(p1s1, p1, "shadow budget 1 vs the path rays' 1");
     EXPECT_GT(p1s8.stats.neural_queries, p1.stats.neural_queries);
     EXPECT_LT(p1s8.stats.neural_leaf_cap_rays, p1.stats.neural_leaf_cap_rays);
     EXPECT_EQ(p1s8_block.image.data, p1s8.image.data);
-    EXPECT_EQ(p1s8_tail.stats.neural_queries, p1s8.stats.neural_queries);
-    EXPECT_EQ(p1s8_tail.stats.neural_leaf_cap_rays, p1s8.stats.neural_leaf_cap_rays);
+    expect_same_rays(p1s8_tail, p1s8, "path 1 shadow 8: tail vs batched");
     EXPECT_LT(image_mean(p8s1_block.image), image_mean(p8s1.image));
     EXPECT_EQ(p8s1.stats.nonfinite_pixels + p1s8.stats.nonfinite_pixels, 0u);
 }
