@@ -8,8 +8,6 @@ namespace nbvh::test {
 
 using namespace nbvh::render;
 
-// 64x64, 4 spp, 3 segments, the scalar MLP, the renderer's defaults otherwise; `tweak` changes options
-// after these (a hybrid render uses the fixture's model unless tweak sets another).
 Rendered render_bunny(const Fixture& f, bool hybrid, const Tweak& tweak) {
     vk::ContextOptions co;
     co.device = vk::DeviceChoice::cpu;
