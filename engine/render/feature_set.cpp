@@ -28,15 +28,15 @@ bool metallic_below_one(const Scene& scene, const Material& m) {
     return false;
 }
 
-// `shadow`: the shadow rays' rounds (the secondary leaf budget's count); else the path rays' (the camera
-// rays' count, the secondary one after the first hit).
+// `shadow`: the shadow rays' rounds (their leaf budget's count); else the path rays' (the camera rays'
+// count, the secondary one after the first hit).
 std::string neural_rounds_text(const NeuralPlan& n, const char* traverse, const char* what, bool shadow) {
     std::string s;
     s += "    passes/ray_sort.comp       rays in (direction levels, origin cell) order (--sort-rays; not camera rays)\n";
     s += strfmt("    %-26s op 0: %s, queues (ray, leaf) pairs (indirect)\n", traverse, what);
     if (n.batched_rounds > 0) {
         if (shadow)
-            s += strfmt("    repeat %u x (batched rounds):\n", n.batched_rounds_secondary);
+            s += strfmt("    repeat %u x (batched rounds):\n", n.batched_rounds_shadow);
         else
             s += strfmt("    repeat %u x (batched rounds; %u after the first hit):\n", n.batched_rounds,
                         n.batched_rounds_secondary);
@@ -173,11 +173,11 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
 namespace {
 
 // The neural rounds of one traversal (WavefrontRenderer::record_neural_rounds): op 0 over every ray, then
-// per batched round the query of the queued pairs and the resumed traversal, then neural_tail.
-void neural_rounds(std::vector<std::string>& passes, const NeuralPlan& n, const char* traverse) {
+// per batched round (`rounds`) the query of the queued pairs and the resumed traversal, then neural_tail.
+void neural_rounds(std::vector<std::string>& passes, const NeuralPlan& n, const char* traverse, uint32_t rounds) {
     passes.push_back("passes/ray_sort.comp"); // bounces > 0 and shadow rays (RenderOptions::sort_rays)
     passes.push_back(traverse);
-    for (uint32_t r = 0; r < n.batched_rounds; ++r) {
+    for (uint32_t r = 0; r < rounds; ++r) {
         passes.push_back("passes/neural_args.comp");
         passes.push_back(n.query_shader);
         passes.push_back(traverse);
@@ -192,7 +192,7 @@ std::vector<std::string> pass_list(const SceneFeatures& f, const NeuralPlan* neu
     const NeuralPlan* n = f.neural ? neural : nullptr;
     std::vector<std::string> passes = {"passes/camera_rays.comp", "passes/queue_args.comp"};
     if (n) {
-        neural_rounds(passes, *n, "passes/neural_traverse.comp");
+        neural_rounds(passes, *n, "passes/neural_traverse.comp", n->batched_rounds);
     } else {
         passes.push_back("passes/ray_sort.comp"); // secondary rays (RenderOptions::sort_rays)
         passes.push_back("passes/traverse.comp");
@@ -200,7 +200,7 @@ std::vector<std::string> pass_list(const SceneFeatures& f, const NeuralPlan* neu
     passes.push_back("passes/shade.comp");
     if (f.has_lights()) {
         passes.push_back("passes/queue_args.comp");
-        if (n) neural_rounds(passes, *n, "passes/neural_shadow.comp");
+        if (n) neural_rounds(passes, *n, "passes/neural_shadow.comp", n->batched_rounds_shadow);
         else passes.push_back("passes/ray_sort.comp");
         passes.push_back("passes/shadow.comp");
     }

@@ -51,9 +51,9 @@ struct NeuralRenderOptions {
     // Leaves queried per ray at most (then the closest hit so far is kept). 8: on the default scene at
     // 1080p, 16 -> 8 -> 6 leaves changed FLIP against the classical reference by < 1e-4 (H200 v3/v4).
     uint32_t max_rounds = 8;
-    // The leaf budget of rays after the first hit and of shadow rays, at most max_rounds (0: max_rounds).
-    // A truncated secondary ray keeps its closest hit so far (a truncated shadow ray:
-    // truncated_shadows_block). 2, with truncated shadow rays blocked (H200, 1080p 16 spp, one call,
+    // The leaf budget of rays after the first hit (and of shadow rays unless max_rounds_shadow), at most
+    // max_rounds (0: max_rounds). A truncated secondary ray keeps its closest hit so far (a truncated
+    // shadow ray: truncated_shadows_occlusion). 2, with truncated shadow rays blocked (H200, 1080p 16 spp, one call,
     // results/perf/secondary_budget2_h200/): against 4 with shadows passing (the default before), the
     // default scene 1.48x -> 1.29x classical for FLIP 0.0133 -> 0.0185 against the converged reference,
     // the dragon 1.81x -> 1.39x for 0.0031 -> 0.0097, Chess 1.37x -> 1.25x for 0.0305 -> 0.0338.

@@ -28,8 +28,9 @@ uint g_nl_budget = 1u;
 uint g_nl_per_round = 1u;
 // Set when the ray was found truncated by its leaf budget (a leaf left in front of its best hit).
 bool g_nl_truncated = false;
-// Shadow rays under --neural-truncated-shadows block: a round that spends the budget looks for one
-// leaf more (nb_nl_want), whose key decides whether the ray is truncated.
+// Shadow rays whose truncation may occlude them (--neural-truncated-shadows block or P > 0): a round
+// that spends the budget looks for one leaf more (nb_nl_want), whose key decides whether the ray is
+// truncated.
 bool g_nl_probe = false;
 uint g_nl_cand_n = 0u;
 float g_nl_cand_t[NB_NL_MAX_LEAVES_PER_ROUND];

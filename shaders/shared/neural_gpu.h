@@ -113,10 +113,11 @@ NB_FN void nb_neural_cull_bounds(NB_INOUT(vec3) lo, NB_INOUT(vec3) hi) {
 // spends the leaf budget (a leaf left is passed). The resumed round then finishes the ray without
 // re-traversing.
 #define NB_NRAY_PENDING_LAST 3u
-// A shadow ray's group is queued that spends its leaf budget under --neural-truncated-shadows block,
-// and its traversal found one leaf more in front of the ray's end (looked for, never queued): its key's
-// distance replaces key_t. The resumed round finishes the ray without re-traversing: occluded by that
-// leaf when no hit of the group occludes it and the leaf lies in front of the ray's end.
+// A shadow ray's group is queued that spends its leaf budget under --neural-truncated-shadows block or
+// P > 0, and its traversal found one leaf more in front of the ray's end (looked for, never queued): its
+// key's distance replaces key_t. The resumed round finishes the ray without re-traversing: occluded by
+// that leaf (with probability P) when no hit of the group occludes it and the leaf lies in front of the
+// ray's end.
 #define NB_NRAY_PENDING_CAP 4u
 struct GpuNeuralRayState {
     vec3 normal;    // world-space unit normal of the best neural hit

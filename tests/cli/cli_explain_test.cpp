@@ -109,6 +109,9 @@ TEST(CliExplain, LeavesPerRoundComeFromTheRenderersStage) {
     EXPECT_TRUE(has(sh.out, "at most 8 (rays after the first hit 1, shadow rays 5), 1 queued per round (the "
                             "others 2): 8 batched rounds (the others 1, shadow rays 3)"))
         << sh.out;
+    // ... and the pass list's rounds of each kind (the shadow rays' 3, not the path rays' 1).
+    EXPECT_TRUE(has(sh.out, "repeat 8 x (batched rounds; 1 after the first hit):")) << sh.out;
+    EXPECT_TRUE(has(sh.out, "repeat 3 x (batched rounds):\n")) << sh.out;
     const auto sh_cap = run_nbvh(explain({"--model", tiny_model().string(), "--neural-max-leaves", "3",
                                           "--neural-max-leaves-shadow", "6"}),
                                  60.0);

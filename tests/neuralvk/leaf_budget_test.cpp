@@ -66,14 +66,14 @@ TEST(HybridRender, TruncatedShadowsPassOrBlock) {
             o.neural.truncated_shadows_occlusion = occlusion;
         };
     };
-    const Rendered pass = render_bunny(f, true, truncate(256, 1, 1, false));
-    const Rendered block = render_bunny(f, true, truncate(256, 1, 1, true));
-    const Rendered block_tail = render_bunny(f, true, truncate(0, 1, 1, true));
+    const Rendered pass = render_bunny(f, true, truncate(256, 1, 1, 0.0f));
+    const Rendered block = render_bunny(f, true, truncate(256, 1, 1, 1.0f));
+    const Rendered block_tail = render_bunny(f, true, truncate(0, 1, 1, 1.0f));
     const Rendered half = render_bunny(f, true, truncate(256, 1, 1, 0.5f)); // some truncated rays occluded
     const Rendered half_tail = render_bunny(f, true, truncate(0, 1, 1, 0.5f));
-    const Rendered block2 = render_bunny(f, true, truncate(256, 2, 4, true)); // looks one leaf further
-    const Rendered block4 = render_bunny(f, true, truncate(256, 4, 4, true)); // resumed once more
-    const Rendered pass4 = render_bunny(f, true, truncate(256, 4, 4, false));
+    const Rendered block2 = render_bunny(f, true, truncate(256, 2, 4, 1.0f)); // looks one leaf further
+    const Rendered block4 = render_bunny(f, true, truncate(256, 4, 4, 1.0f)); // resumed once more
+    const Rendered pass4 = render_bunny(f, true, truncate(256, 4, 4, 0.0f));
     EXPECT_EQ(pass.validation + block.validation + block_tail.validation + block2.validation +
                   block4.validation + pass4.validation,
               0);
