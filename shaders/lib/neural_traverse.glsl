@@ -276,13 +276,14 @@ void nb_nl_finish_path(uint i, inout GpuNeuralRayState st) {
 // Whether shadow ray `ray` (its index in the shadow queue), truncated by its leaf budget, is occluded:
 // with probability truncated_shadows_occlusion (--neural-truncated-shadows: block 1, pass 0, or P), drawn
 // from a hash of its pixel, sample and bounce (as its alpha-test seed, decorrelated), so that every pass
-// that decides it (neural_shadow's rounds, neural_tail) draws the same. The leaf left in front of the
-// ray holds occupied cells along it (a candidate passed the occupancy walk).
+// that decides it (neural_shadow's rounds, neural_tail) draws the same: the blended-alpha rule of
+// shared/scene_gpu.h nb_alpha_covers with alpha P. The leaf left in front of the ray holds occupied
+// cells along it (a candidate passed the occupancy walk).
 bool nb_nl_truncated_shadow_occluded(uint ray) {
     float p = neural_params.truncated_shadows_occlusion;
-    if (p >= 1.0f) return true;
+    if (p >= 1.0f) return true; // block (the default): no draw
     uint seed = nb_shadow_alpha_seed(shadow_load1(NB_SHADOW_PIXEL, ray) & ~NB_RAY_BACKFACE_BIT);
-    return float(nb_pcg_hash(seed ^ 0x5bd1e995u) >> 8u) * (1.0f / 16777216.0f) < p;
+    return nb_alpha_covers(NB_ALPHA_BLEND, p, 0.0f, nb_pcg_hash(seed ^ 0x5bd1e995u));
 }
 bool nb_nl_shadow_blocked(uint ray) { return g_nl_truncated && g_nl_probe && nb_nl_truncated_shadow_occluded(ray); }
 
