@@ -16,6 +16,21 @@ namespace nbvh::app {
 
 namespace {
 
+// --neural-truncated-shadows block|pass|P: the probability that a truncated shadow ray is occluded, or
+// -1 for a word that is none of them (the whole word a number in [0, 1]).
+float truncated_shadows_occlusion(const std::string& v) {
+    if (v == "block") return 1.0f;
+    if (v == "pass") return 0.0f;
+    size_t used = 0;
+    float p = -1.0f;
+    try {
+        p = std::stof(v, &used);
+    } catch (const std::exception&) {
+        return -1.0f;
+    }
+    return used == v.size() && p >= 0.0f && p <= 1.0f ? p : -1.0f;
+}
+
 // --sampler sobol|random (render::sampler_name is the flag's word).
 void add_sampler_flag(CLI::App* cmd, render::Sampler& sampler) {
     cmd->add_option_function<std::string>(
@@ -53,23 +68,12 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
         ->check(CLI::Range(0u, 256u));
     cmd->add_option_function<std::string>(
            "--neural-truncated-shadows",
-           [&o](const std::string& v) {
-               o.neural.truncated_shadows_occlusion = v == "block" ? 1.0f : v == "pass" ? 0.0f : std::stof(v);
-           },
+           [&o](const std::string& v) { o.neural.truncated_shadows_occlusion = truncated_shadows_occlusion(v); },
            "a shadow ray truncated by its leaf budget (a leaf left in front of its end; with occupancy "
            "masks, one whose cells along the ray are occupied): occluded by that leaf (block, default), "
            "unoccluded (pass), or occluded with probability P in [0, 1] (a hash of the ray)")
         ->check([](const std::string& v) -> std::string {
-            if (v == "block" || v == "pass") return "";
-            size_t used = 0;
-            float p = -1.0f;
-            try {
-                p = std::stof(v, &used);
-            } catch (const std::exception&) {
-                used = 0;
-            }
-            return used == v.size() && p >= 0.0f && p <= 1.0f ? ""
-                                                               : "must be block, pass or a probability in [0, 1]";
+            return truncated_shadows_occlusion(v) >= 0.0f ? "" : "must be block, pass or a probability in [0, 1]";
         });
     cmd->add_option("--neural-batched-rounds", o.neural.batched_rounds,
                     "leaf rounds through the batched query pass before the per-ray tail pass");
