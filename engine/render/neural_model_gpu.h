@@ -108,7 +108,8 @@ class NeuralEvaluator {
 public:
     // part (cooperative-matrix kernels only, benchmark breakdown): 0 full, 1 features only, 2 MLP only;
     // the split query (fp32 accumulators): 3 gather kernel then MLP kernel, 4 its gather kernel only,
-    // 5 its MLP kernel only (on the features of the last part 3 or 4 dispatch).
+    // 5 its MLP kernel only (on the features of the last part 3 or 4 dispatch), 6 the split query
+    // pipelined (set_pipeline: chunk c's gather beside chunk c - 1's MLP).
     NeuralEvaluator(const vk::Context& ctx, const NeuralModelGpu& model, NeuralKernelChoice choice,
                     uint32_t part = 0);
     const NeuralKernelChoice& choice() const { return choice_; }
@@ -120,6 +121,16 @@ public:
     // upload_queries() (timestamps; 0 without). For the benchmark.
     void upload_queries(const std::vector<GpuNeuralQuery>& queries);
     double time_dispatch(uint32_t count, int repetitions, float threshold = NB_VISIBILITY_THRESHOLD);
+    // Part 6, the split query pipelined: the queries in `chunks` chunks; each chunk's gather kernel is a
+    // grid of at most `groups` workgroups looping over the chunk (its residency capped, so that the
+    // previous chunk's MLP kernel, recorded after it with no barrier between them, finds room on every
+    // SM). The default (pipeline_for): 8 chunks, 6 workgroups per SM; one chunk (the plain split query)
+    // where the SM count is unknown. H200: results/neural/README.md.
+    struct Pipeline {
+        uint32_t chunks = 1, groups = ~0u; // groups ~0u: uncapped
+    };
+    static Pipeline pipeline_for(const vk::DeviceFeatures& dev);
+    void set_pipeline(const Pipeline& p);
 
 private:
     void ensure_capacity(size_t count);
@@ -130,6 +141,7 @@ private:
     vk::ComputePipeline pipeline_, gather_;
     vk::Buffer queries_, hits_, features_;
     size_t capacity_ = 0;
+    Pipeline pipeline_opts_;
 };
 
 } // namespace nbvh::render

@@ -117,6 +117,7 @@ struct DeviceFeatures {
     uint32_t subgroup_size = 0;
     uint32_t min_subgroup_size = 0, max_subgroup_size = 0; // equal to subgroup_size without control
     uint32_t max_shared_memory = 0;          // bytes per workgroup
+    uint32_t sm_count = 0;                   // NVIDIA's SMs (VK_NV_shader_sm_builtins; 0: unknown)
     uint64_t max_storage_buffer_range = 0;   // bytes per storage-buffer binding
     uint64_t max_allocation_size = 0;        // bytes per VkDeviceMemory
     uint64_t device_local_bytes = 0;         // the largest device-local memory heap (0: unknown)

@@ -129,7 +129,8 @@ std::string DeviceFeatures::summary() const {
     s += strfmt("  subgroup size %u (min %u, max %u, control %s), shared memory %u B, storage range %llu B\n",
                 subgroup_size, min_subgroup_size, max_subgroup_size, yn(subgroup_size_control),
                 max_shared_memory, (unsigned long long)max_storage_buffer_range);
-    s += strfmt("  timestamps: %u valid bits, %.3f ns/tick\n", timestamp_valid_bits, double(timestamp_period));
+    s += strfmt("  timestamps: %u valid bits, %.3f ns/tick; SMs %s\n", timestamp_valid_bits, double(timestamp_period),
+                sm_count ? std::to_string(sm_count).c_str() : "unknown");
     s += strfmt("  VK_NV_cooperative_matrix: %s", yn(coop_matrix_nv));
     for (const CoopMatrixShape& c : coop_matrix_shapes) s += "\n    " + c.describe();
     return s;
@@ -195,6 +196,7 @@ void Context::create_device(const std::vector<std::string>& extra_extensions) {
     const bool has_coop = has_extension(exts, VK_NV_COOPERATIVE_MATRIX_EXTENSION_NAME);
     const bool has_nsi = has_extension(exts, VK_KHR_SHADER_NON_SEMANTIC_INFO_EXTENSION_NAME);
     const bool has_pep = has_extension(exts, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
+    const bool has_sm = has_extension(exts, VK_NV_SHADER_SM_BUILTINS_EXTENSION_NAME); // properties only
 
     // What the device supports.
     VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR pep{
@@ -215,8 +217,12 @@ void Context::create_device(const std::vector<std::string>& extra_extensions) {
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_PROPERTIES_EXT};
     VkPhysicalDeviceVulkan12Properties p12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_PROPERTIES};
     VkPhysicalDeviceVulkan11Properties p11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_PROPERTIES, &p12};
+    VkPhysicalDeviceShaderSMBuiltinsPropertiesNV sm_props{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_SM_BUILTINS_PROPERTIES_NV};
     VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &p11};
-    if (has_ssc) p12.pNext = &ssc_props;
+    void** ptail = &p12.pNext;
+    if (has_ssc) { *ptail = &ssc_props; ptail = &ssc_props.pNext; }
+    if (has_sm) { *ptail = &sm_props; ptail = &sm_props.pNext; }
     vkGetPhysicalDeviceProperties2(physical_, &p2);
     vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
     const VkPhysicalDeviceProperties& props = p2.properties;
@@ -252,6 +258,7 @@ void Context::create_device(const std::vector<std::string>& extra_extensions) {
                          (p11.subgroupSupportedOperations & VK_SUBGROUP_FEATURE_SHUFFLE_BIT);
     d.min_subgroup_size = d.subgroup_size_control ? ssc_props.minSubgroupSize : p11.subgroupSize;
     d.max_subgroup_size = d.subgroup_size_control ? ssc_props.maxSubgroupSize : p11.subgroupSize;
+    d.sm_count = has_sm ? sm_props.shaderSMCount : 0u;
     d.max_shared_memory = props.limits.maxComputeSharedMemorySize;
     d.max_storage_buffer_range = props.limits.maxStorageBufferRange;
     d.max_allocation_size = p11.maxMemoryAllocationSize;

@@ -1,6 +1,9 @@
 // Body of passes/neural_eval_coop{16,32}.comp (the includer defines NB_COOP_ACC_BITS): 64 queries per
 // workgroup through the fused cooperative-matrix MLP.
 #include "lib/neural_eval_common.glsl"
+// The workgroup's first query.
+uint nb_group_first;
+#define NB_SPLIT_GROUP_FIRST nb_group_first
 layout(set = 0, binding = NB_NEVAL_BIND_MLP, std430) readonly buffer MlpBuffer { uvec4 neural_mlp_tiles[]; };
 #ifdef NB_SPLIT_FEATURES
 layout(set = 0, binding = NB_NEVAL_BIND_FEATURES, std430) readonly buffer FeatureBuffer { uvec2 split_features[]; };
@@ -16,9 +19,10 @@ layout(local_size_x = NB_NEURAL_GROUP) in;
 // of the query index instead of grid lookups). Results of parts 1 and 2 are meaningless by design.
 layout(constant_id = 0) const uint NB_EVAL_PART = 0u;
 
-void main() {
-    uint i = gl_GlobalInvocationID.x;
+// The 64 queries from nb_group_first on.
+void nb_eval_group() {
     uint local = gl_LocalInvocationID.x;
+    uint i = nb_group_first + local;
     bool valid = i < pc.count;
     GpuNeuralQuery q = nb_eval_query(i, valid);
     vec3 p0, p1, p2;
@@ -57,4 +61,9 @@ void main() {
         y[r] = nb_sigmoid(pre);
     }
     hits[i] = nb_neural_decode(pc.box, y, q.t_entry, q.t_exit, length(q.dir), pc.threshold);
+}
+
+void main() {
+    nb_group_first = pc.first + gl_WorkGroupID.x * NB_NEURAL_GROUP; // queries [pc.first, pc.count)
+    nb_eval_group();
 }

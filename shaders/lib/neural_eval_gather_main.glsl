@@ -9,11 +9,17 @@ layout(set = 0, binding = NB_NEVAL_BIND_FEATURES, std430) writeonly buffer Featu
 
 layout(local_size_x = NB_NEURAL_GROUP) in;
 
+// Queries [pc.first, pc.count). A grid of fewer workgroups than the range needs loops over it (the
+// pipelined split query of NeuralEvaluator caps the gather's residency so that the previous chunk's MLP
+// kernel runs beside it); the loop's condition is uniform over the workgroup (shuffles need every lane).
 void main() {
-    uint i = gl_GlobalInvocationID.x;
-    bool valid = i < pc.count;
-    GpuNeuralQuery q = nb_eval_query(i, valid);
-    vec3 p0, p1, p2;
-    nb_segment_points(pc.box, q.origin, q.dir, q.t_entry, q.t_exit, p0, p1, p2);
-    NB_SPLIT_GATHER_STORE(i, valid, p0, p1, p2)
+    for (uint base = pc.first + gl_WorkGroupID.x * NB_NEURAL_GROUP; base < pc.count;
+         base += gl_NumWorkGroups.x * NB_NEURAL_GROUP) {
+        uint i = base + gl_LocalInvocationID.x;
+        bool valid = i < pc.count;
+        GpuNeuralQuery q = nb_eval_query(i, valid);
+        vec3 p0, p1, p2;
+        nb_segment_points(pc.box, q.origin, q.dir, q.t_entry, q.t_exit, p0, p1, p2);
+        NB_SPLIT_GATHER_STORE(i, valid, p0, p1, p2)
+    }
 }

@@ -98,11 +98,14 @@ float nb_coop_x_read(uint row, uint f) {
     coopMatLoadNV(A, nb_sh_x, (ROW) * NB_COOP_STRIDE_V + (KT) * 2u, NB_COOP_STRIDE_V, false)
 #ifdef NB_SPLIT_FEATURES
 // ... of the features in the split query's features buffer (shared/neural_gpu.h nb_split_tile_word: the
-// workgroup's pairs gl_WorkGroupID.x * NB_NEURAL_GROUP + row; the includer declares `uvec4
-// split_feature_tiles[]`), straight from global memory. Rows of invalid pairs hold stale or unwritten
+// workgroup's pairs NB_SPLIT_GROUP_FIRST + row, by default gl_WorkGroupID.x * NB_NEURAL_GROUP; the includer
+// declares `uvec4 split_feature_tiles[]`), straight from global memory. Rows of invalid pairs hold stale or unwritten
 // features: a row's products depend on that row alone, and its outputs are not used.
+#ifndef NB_SPLIT_GROUP_FIRST
+#define NB_SPLIT_GROUP_FIRST (gl_WorkGroupID.x * NB_NEURAL_GROUP)
+#endif
 #define NB_COOP_LOAD_A_SPLIT(A, ROW, KT)                                                              \
-    coopMatLoadNV(A, split_feature_tiles, nb_split_tile_word(gl_WorkGroupID.x * NB_NEURAL_GROUP + (ROW), (KT)), \
+    coopMatLoadNV(A, split_feature_tiles, nb_split_tile_word(NB_SPLIT_GROUP_FIRST + (ROW), (KT)),     \
                   NB_SPLIT_TILE_ROW_WORDS, false)
 #endif
 

@@ -9,7 +9,7 @@ layout(set = 0, binding = NB_NEVAL_BIND_MLP, scalar) readonly buffer MlpBuffer {
 layout(local_size_x = NB_NEURAL_GROUP) in;
 
 void main() {
-    uint i = gl_GlobalInvocationID.x;
+    uint i = pc.first + gl_GlobalInvocationID.x;
     if (i >= pc.count) return;
     GpuNeuralQuery q = queries[i];
     vec3 p0, p1, p2;

@@ -46,9 +46,9 @@ NB_STATIC_ASSERT(sizeof(GpuNeuralHit) == 48, "GpuNeuralHit layout");
 // Push constants of the eval kernels (the encoding box of the one asset the queries belong to).
 struct GpuNeuralEvalPush {
     GpuEncodingBox box;
-    uint count;        // queries
+    uint count;        // queries: the dispatch's valid indices are [first, count)
     float threshold;   // visibility threshold (NB_VISIBILITY_THRESHOLD by default)
-    uint pad0;
+    uint first;        // index of the dispatch's first query (a multiple of NB_NEURAL_GROUP)
     uint pad1;
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralEvalPush) == 48, "GpuNeuralEvalPush layout");

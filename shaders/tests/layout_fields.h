@@ -101,7 +101,7 @@
 #define NB_LAYOUT_FIELDS_GpuNeuralHit(F) \
     F(normal) F(t) F(albedo) F(visibility) F(depth) F(flags) F(pad0) F(pad1)
 #define NB_LAYOUT_FIELDS_GpuNeuralEvalPush(F) \
-    F(box.center) F(box.depth_pad) F(box.extent) F(box.fixed_depth_eps) F(count) F(threshold) F(pad0) F(pad1)
+    F(box.center) F(box.depth_pad) F(box.extent) F(box.fixed_depth_eps) F(count) F(threshold) F(first) F(pad1)
 #define NB_LAYOUT_FIELDS_GpuNeuralRayState(F)                                                     \
     F(normal) F(best_t) F(albedo_rg) F(albedo_b) F(hit_leaf) F(instance) F(key_t) F(key_instance)    \
     F(key_leaf) F(status)                                                                         \

@@ -2,6 +2,8 @@
 // and the cooperative-matrix path on the same random queries, and how far the two paths agree.
 //   nbvh_bench_neural [--model M.nbvh] [--queries N] [--reps R] [--device auto|gpu|cpu] [--json out.json]
 //                     [--coherent]   (camera-ray ordered queries instead of random ones)
+//                     [--pipeline C:G,...]  (more rows of the pipelined split query: C chunks, gather grids
+//                                            of G workgroups)
 // Without --model a random network with varied outputs (tests/neuralvk/neural_test_model.h, hash 2^18,
 // the paper's size) is used: the kernels' cost does not depend on the weights' values.
 // Queries: random rays through random leaf-sized boxes of the asset, a quarter starting inside.
@@ -82,6 +84,7 @@ int main(int argc, char** argv) try {
     size_t n = size_t(1) << 22;
     int reps = 10;
     bool coherent = false;
+    std::vector<NeuralEvaluator::Pipeline> pipelines;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
@@ -94,6 +97,21 @@ int main(int argc, char** argv) try {
         else if (a == "--device") device = next();
         else if (a == "--json") json_path = next();
         else if (a == "--coherent") coherent = true;
+        else if (a == "--pipeline") {
+            const std::string v = next();
+            for (size_t at = 0; at < v.size();) {
+                size_t end = v.find(',', at);
+                if (end == std::string::npos) end = v.size();
+                const std::string item = v.substr(at, end - at);
+                const size_t colon = item.find(':');
+                if (colon == std::string::npos) throw Error("--pipeline wants C:G items, got " + item);
+                NeuralEvaluator::Pipeline pl;
+                pl.chunks = uint32_t(std::stoul(item.substr(0, colon)));
+                pl.groups = uint32_t(std::stoul(item.substr(colon + 1)));
+                pipelines.push_back(pl);
+                at = end + 1;
+            }
+        }
         else throw Error("unknown option " + a);
     }
     vk::ContextOptions o;
@@ -147,7 +165,32 @@ int main(int argc, char** argv) try {
         for (size_t i = 0; i < qs.size(); ++i)
             if (std::memcmp(&r.hits[i], &rows[1].hits[i], sizeof(GpuNeuralHit)) != 0) ++split_differs;
         std::printf("split vs fused coopmat: %zu of %zu hits differ (bitwise)\n", split_differs, qs.size());
+        const size_t split_row = rows.size();
         rows.push_back(std::move(r));
+        // The pipelined split query: the device's default (a row of the JSON), then any --pipeline rows.
+        pipelines.insert(pipelines.begin(), NeuralEvaluator::pipeline_for(dev));
+        for (size_t k = 0; k < pipelines.size(); ++k) {
+            const NeuralEvaluator::Pipeline& pl = pipelines[k];
+            NeuralEvaluator pe(ctx, gpu, c, 6);
+            pe.set_pipeline(pl);
+            Row p;
+            p.path = std::string(k == 0 ? "split pipelined (default): " : "split pipelined: ") +
+                     std::to_string(pl.chunks) + " chunks, gather grids of " +
+                     (pl.groups == ~0u ? std::string("any size") : std::to_string(pl.groups));
+            p.hits = pe.evaluate(qs);
+            // The plain split query timed right before and after, in the same state of the GPU.
+            const double before = ev.time_dispatch(uint32_t(qs.size()), reps);
+            p.ms = pe.time_dispatch(uint32_t(qs.size()), reps);
+            const double after = ev.time_dispatch(uint32_t(qs.size()), reps);
+            p.qps = p.ms > 0 ? double(qs.size()) / (p.ms * 1e-3) : 0.0;
+            size_t differs = 0;
+            for (size_t i = 0; i < qs.size(); ++i)
+                if (std::memcmp(&p.hits[i], &rows[split_row].hits[i], sizeof(GpuNeuralHit)) != 0) ++differs;
+            std::printf("%-70s %9.3f ms / %zu queries = %.3f G queries/s (%zu hits differ from the split query; "
+                        "the split query right before / after %.3f / %.3f ms)\n",
+                        p.path.c_str(), p.ms, qs.size(), p.qps * 1e-9, differs, before, after);
+            if (k == 0) rows.push_back(std::move(p));
+        }
         NeuralEvaluator ge(ctx, gpu, c, 4);
         ge.evaluate(qs);
         ms_split_gather = ge.time_dispatch(uint32_t(qs.size()), reps);

@@ -76,6 +76,21 @@ TEST(NeuralCoopmat, KernelsMatchFp16Reference) {
         size_t differ = 0;
         for (size_t i = 0; i < a.size(); ++i) differ += std::memcmp(&a[i], &b[i], sizeof(GpuNeuralHit)) != 0;
         EXPECT_EQ(differ, 0u) << "of " << a.size() << " split hits differ from the fused kernel's";
+        // Pipelined (part 6): chunks of whole workgroups with a partial last one, gather grids smaller
+        // and larger than a chunk's workgroups (the loop over the chunk, and no loop), and the device's
+        // default.
+        for (const NeuralEvaluator::Pipeline& pl :
+             {NeuralEvaluator::Pipeline{1, 1000}, NeuralEvaluator::Pipeline{3, 7}, NeuralEvaluator::Pipeline{7, 64},
+              NeuralEvaluator::pipeline_for(ctx->features())}) {
+            NeuralEvaluator piped(*ctx, gpu, choices[0], 6);
+            piped.set_pipeline(pl);
+            const std::vector<GpuNeuralHit> c = piped.evaluate(qs);
+            ASSERT_EQ(c.size(), a.size());
+            size_t pdiffer = 0;
+            for (size_t i = 0; i < a.size(); ++i) pdiffer += std::memcmp(&a[i], &c[i], sizeof(GpuNeuralHit)) != 0;
+            EXPECT_EQ(pdiffer, 0u) << pl.chunks << " chunks, gather grids of " << pl.groups << ": of " << a.size()
+                                   << " pipelined hits differ from the fused kernel's";
+        }
     }
     EXPECT_EQ(ctx->validation_message_count(), 0);
 }
