@@ -313,11 +313,10 @@ void NeuralEvaluator::set_pipeline(const Pipeline& p) {
 NeuralEvaluator::Pipeline NeuralEvaluator::pipeline_for(const vk::DeviceFeatures& dev) {
     Pipeline p;
     if (dev.sm_count == 0) return p; // one chunk, the gather grid as large as it needs (capped below)
-    // H200 (132 SMs), 4M random queries: 8 chunks of gather grids of 792 workgroups 2.934 ms against
-    // 3.597 for the plain split query; 4 to 16 chunks and 4 to 12 workgroups per SM within 5 %, grids of
-    // 2 per SM 3x slower (results/neural/README.md).
+    // H200 (132 SMs), 4M random queries: 8 chunks 2.959 ms against 3.547 for the plain split query; 4
+    // and 16 chunks 2.990 / 3.069 (results/neural/README.md).
     p.chunks = 8;
-    p.groups = 6 * dev.sm_count;
+    p.groups = SPLIT_GATHER_GROUPS_PER_SM * dev.sm_count;
     return p;
 }
 
