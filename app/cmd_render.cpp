@@ -91,7 +91,6 @@ nlohmann::json settings_json(const RenderArgs& a, const render::RenderOptions& o
                        {"backface_escape", n.backface_escape},
                        {"query", n.split_query ? "split" : "fused"}, // requested; neural.path says what ran
                        {"split_min_pairs", n.split_min_pairs},
-                       {"split_chunks", n.split_chunks}, // requested; 0 = auto
                        {"roughness_override", n.roughness},
                        {"metallic_override", n.metallic}};
     }

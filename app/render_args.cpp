@@ -119,12 +119,6 @@ void add_render_option_flags(CLI::App* cmd, render::RenderOptions& o) {
            "0: every round splits (default " +
                std::to_string(render::DEFAULT_SPLIT_MIN_PAIRS) + ")")
         ->check(CLI::Range(0u, 1u << 30));
-    cmd->add_option(
-           "--neural-split-chunks", o.neural.split_chunks,
-           "the split query pass pipelined: a round's pairs in this many chunks, each chunk's gather pass "
-           "beside the previous chunk's MLP pass (1: one chunk, the gather then the MLP; 0: auto, " +
-               std::to_string(NB_SPLIT_MAX_CHUNKS) + " where the device tells its SM count, default); same image")
-        ->check(CLI::Range(0u, NB_SPLIT_MAX_CHUNKS));
     cmd->add_option_function<std::string>(
            "--sort-rays", [&o](const std::string& v) { o.sort_rays = v == "on"; },
            "trace secondary and shadow rays grouped by direction and origin (on, default) "

@@ -44,10 +44,6 @@ std::string neural_rounds_text(const NeuralPlan& n, const char* traverse, const 
         if (n.split_query) {
             s += "      passes/neural_gather.comp  hash grid of the queued pairs -> features (--neural-query)\n";
             s += "      passes/neural_query_mlp32.comp MLP of those features -> the pairs' hits\n";
-            if (n.split_chunks > 1)
-                s += strfmt("      %-26s in %u chunks, each chunk's gather beside the previous chunk's MLP "
-                            "(--neural-split-chunks)\n",
-                            "", n.split_chunks);
             if (n.split_fused_rest)
                 s +=
                     strfmt("      %-26s the rest: a round below --neural-split-min-pairs whole, or the pairs "
@@ -147,7 +143,6 @@ std::optional<NeuralPlan> plan_neural(const vk::Context* ctx, const Scene& scene
     p.kernel = stage.query_description();
     p.split_query = stage.split();
     p.split_fused_rest = stage.split_overflow();
-    p.split_chunks = stage.split_chunks();
     p.query_shader = stage.query_shader();
     p.lod_primary = stage.params().lod_primary;
     p.lod_secondary = stage.params().lod_secondary;

@@ -65,7 +65,6 @@ struct NeuralPlan {
     std::string query_shader;      // shader of the batched query pass (the fused one)
     bool split_query = false;      // the query pass as neural_gather + neural_query_mlp32 (--neural-query)
     bool split_fused_rest = false; // ... and the fused pass after them (NeuralStage::split_overflow)
-    uint32_t split_chunks = 1;     // ... in chunks, gathers beside MLPs (NeuralStage::split_chunks)
     uint32_t lod_primary = 0, lod_secondary = 0, lod_count = 1; // N-BVH cuts (0 = finest) of the model
     uint32_t leaf_budget = 0;              // leaves queried per camera ray at most (--neural-max-leaves)
     uint32_t leaf_budget_secondary = 0;    // ... per ray after the first hit (--neural-max-leaves-secondary)

@@ -103,9 +103,10 @@ private:
     uint64_t bytes_ = 0;
 };
 
-// Workgroups per SM of the pipelined split query's gather grids (NeuralEvaluator part 6 and the
-// renderer's split pass, GpuNeuralParams::split_gather_groups): H200, 4M random queries, 8 chunks: 4, 6
-// and 8 per SM 3.190 / 2.959 / 2.966 ms, 12 and 16 per SM 3.44-3.47 (results/neural/README.md).
+// Workgroups per SM of the pipelined split query's gather grids (NeuralEvaluator part 6): H200, 4M
+// random queries, 8 chunks: 4, 6 and 8 per SM 3.190 / 2.959 / 2.966 ms, 12 and 16 per SM 3.44-3.47
+// (results/neural/README.md). The renderer's split pass is not pipelined: its queries are coherent
+// enough that it ran slower so (results/perf/dropped/README.md).
 inline constexpr uint32_t SPLIT_GATHER_GROUPS_PER_SM = 6;
 
 // Runs the flat-list query kernels.

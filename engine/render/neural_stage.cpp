@@ -139,8 +139,6 @@ NeuralStage::NeuralStage(const vk::Context& ctx, const NeuralModel& model, const
     }
 }
 
-uint32_t default_split_chunks(const vk::DeviceFeatures& device) { return device.sm_count > 0 ? 4u : 1u; }
-
 uint32_t plan_split_query(uint64_t pairs_per_half, uint64_t buffer_bytes, uint64_t limit) {
     constexpr uint64_t quad_bytes = 8ull * NB_SPLIT_FEATURE_QUADS;
     const uint64_t group = NB_NEURAL_GROUP;
@@ -229,13 +227,6 @@ void NeuralStage::set_params(const NeuralRenderOptions& o) {
     params_.max_rounds_shadow = shadow_budget;
     params_.truncated_shadows_occlusion = std::clamp(o.truncated_shadows_occlusion, 0.0f, 1.0f);
     params_.split_min_pairs = o.split_min_pairs;
-    const vk::DeviceFeatures& dev = ctx_.features();
-    params_.split_chunks = std::clamp(o.split_chunks == 0 ? default_split_chunks(dev) : o.split_chunks, 1u,
-                                      NB_SPLIT_MAX_CHUNKS);
-    // Without the SM count only one chunk runs by default, its gather grid uncapped.
-    params_.split_gather_groups = o.split_gather_groups > 0 ? o.split_gather_groups
-                                  : dev.sm_count > 0        ? SPLIT_GATHER_GROUPS_PER_SM * dev.sm_count
-                                                            : 0xFFFFFFFFu;
     params_.occupancy = o.occupancy ? model_.occupancy_offset() : 0u;
     params_.materials = o.materials != NeuralMaterials::asset ? model_.materials_offset() : 0u;
     const bool fits = o.materials == NeuralMaterials::fit || o.materials == NeuralMaterials::mix;

@@ -119,19 +119,7 @@ struct NeuralRenderOptions {
     // kernel fills the GPU about once (the last bounces), the split pass's two dispatches cost more than
     // they save. 0: every round takes the split pass. Same image either way. --neural-split-min-pairs.
     uint32_t split_min_pairs = DEFAULT_SPLIT_MIN_PAIRS;
-    // The split query pass pipelined: a round's split pairs in this many chunks (at most
-    // NB_SPLIT_MAX_CHUNKS), chunk c's gather pass (its grid capped at 6 workgroups per SM) beside chunk
-    // c - 1's MLP pass; 1: one chunk, the gather then the MLP; 0 (auto): split_chunks_for(device). Same
-    // image either way. --neural-split-chunks.
-    uint32_t split_chunks = 0;
-    // Workgroups of each chunk's gather grid at most (0: SPLIT_GATHER_GROUPS_PER_SM per SM); tests use
-    // it to make the gather loop over its chunk.
-    uint32_t split_gather_groups = 0;
 };
-
-// The pipelined split pass's chunks where NeuralRenderOptions::split_chunks is 0 (auto): 4 where the
-// device tells its SM count (VK_NV_shader_sm_builtins), else 1.
-uint32_t default_split_chunks(const vk::DeviceFeatures& device);
 
 // Pending-queue pairs per ray of `options`: the larger of its leaves per round of camera rays and of the
 // others (throws nbvh::Error when either is out of range).
@@ -192,8 +180,6 @@ public:
     // NB_BIND_OUTPUT in the split passes' descriptor sets, lib/bindings.glsl).
     bool split() const { return params_.split_chunk > 0; }
     bool split_overflow() const { return split() && (split_fills_ || params_.split_min_pairs > 0); }
-    // Chunks of the pipelined split pass (1: not pipelined).
-    uint32_t split_chunks() const { return split() ? params_.split_chunks : 1u; }
     const vk::Buffer& split_features() const { return split_features_; }
     std::string query_description() const;
     uint32_t rounds() const { return rounds_; }

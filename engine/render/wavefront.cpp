@@ -411,43 +411,12 @@ void WavefrontRenderer::record_query(vk::CommandBuffer& cmd, const GpuPassConsta
     }
     // The round's first split_chunk pairs (neural_args wrote the dispatches); where a round can hold
     // more than the features buffer, the fused pass takes the rest (none in most rounds).
-    if (neural_->split_chunks() > 1) {
-        record_split_pipelined(cmd, pc);
-    } else {
-        record_pass(cmd, NEURAL_GATHER, pc, Dispatch::indirect_split);
-        record_pass(cmd, NEURAL_MLP, pc, Dispatch::indirect_split);
-    }
+    record_pass(cmd, NEURAL_GATHER, pc, Dispatch::indirect_split);
+    record_pass(cmd, NEURAL_MLP, pc, Dispatch::indirect_split);
     if (neural_->split_overflow()) {
         GpuPassConstants rest = pc;
         rest.mode |= NB_QUERY_MODE_OVERFLOW;
         record_pass(cmd, NEURAL_QUERY, rest, Dispatch::indirect_overflow);
-    }
-}
-
-// The pipelined split pass: chunk c's gather pass (its grid capped) and chunk c - 1's MLP pass with no
-// barrier between them, timed together as the query pass (the first chunk's gather alone as the gather
-// pass); a barrier after each pair.
-void WavefrontRenderer::record_split_pipelined(vk::CommandBuffer& cmd, const GpuPassConstants& pc) {
-    const uint32_t chunks = neural_->split_chunks();
-    const vk::Buffer& counters = buffers_[NB_BIND_NEURAL_COUNTERS];
-    auto with_chunk = [&](uint32_t c) {
-        GpuPassConstants p = pc;
-        p.mode |= c << NB_QUERY_CHUNK_SHIFT;
-        return p;
-    };
-    for (uint32_t c = 0; c <= chunks; ++c) {
-        cmd.begin_pass(PASS_SHADERS[c == 0 ? NEURAL_GATHER : NEURAL_QUERY], timer_.available() ? &timer_ : nullptr,
-                       pc.depth);
-        if (c < chunks)
-            cmd.bind(pipelines_[NEURAL_GATHER], sets_[NEURAL_GATHER])
-                .push(with_chunk(c))
-                .dispatch_indirect(counters, NB_NEURAL_CHUNK_GATHER_OFFSET(c));
-        if (c > 0)
-            cmd.bind(pipelines_[NEURAL_MLP], sets_[NEURAL_MLP])
-                .push(with_chunk(c - 1))
-                .dispatch_indirect(counters, NB_NEURAL_CHUNK_MLP_OFFSET(c - 1));
-        cmd.end_pass();
-        cmd.barrier(vk::Barrier::compute_to_compute);
     }
 }
 

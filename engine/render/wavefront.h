@@ -177,7 +177,6 @@ private:
     // The query pass of one round: fused, or the split pass's gather and MLP passes (and the fused pass
     // for the pairs past the split pass's features buffer).
     void record_query(vk::CommandBuffer& cmd, const GpuPassConstants& pc);
-    void record_split_pipelined(vk::CommandBuffer& cmd, const GpuPassConstants& pc);
     void record_sample_wave(vk::CommandBuffer& cmd, const Wave& w);
     void record_neural_rounds(vk::CommandBuffer& cmd, size_t traverse_pass, uint32_t q, uint32_t depth, const Wave& w);
     // Records passes/ray_sort.comp for the path queue q (not camera rays) or the shadow queue when the

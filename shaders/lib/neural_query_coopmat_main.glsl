@@ -4,12 +4,6 @@
 // the features straight from the buffer passes/neural_gather.comp wrote for the round's first
 // split_chunk pairs).
 #include "lib/bindings.glsl"
-#ifdef NB_SPLIT_FEATURES
-// The workgroup's first pair: the MLP pass runs chunk (pc.mode >> NB_QUERY_CHUNK_SHIFT) of the split pairs
-// (passes/neural_args.comp), one workgroup per 64 pairs.
-uint nb_group_first;
-#define NB_SPLIT_GROUP_FIRST nb_group_first
-#endif
 #define NB_NEURAL_MLP_AS_TILES 1
 #include "lib/neural_bindings.glsl"
 #include "lib/neural_grid.glsl"
@@ -21,9 +15,7 @@ layout(local_size_x = NB_NEURAL_GROUP) in;
 void main() {
 #ifdef NB_SPLIT_FEATURES
     // The features stay in the buffer: the MLP's first layer loads them (nb_mlp_forward_coopmat_split).
-    uint chunk = (pc.mode >> NB_QUERY_CHUNK_SHIFT) & (NB_SPLIT_MAX_CHUNKS - 1u);
-    nb_group_first = (chunk * neural_counters.split_chunk_groups + gl_WorkGroupID.x) * NB_NEURAL_GROUP;
-    NbPendingQuery r = nb_load_pending(nb_group_first + gl_LocalInvocationID.x);
+    NbPendingQuery r = nb_load_pending(gl_GlobalInvocationID.x);
 #else
     NbPendingQuery r = nb_load_pending(nb_query_first_pair() + gl_GlobalInvocationID.x);
     vec3 p0, p1, p2;

@@ -2,8 +2,7 @@
 // far to the query pass (pending_active), empties the queue for the next round, writes the indirect
 // dispatch arguments (NB_NEURAL_GROUP pairs per workgroup; the split query pass: its first
 // neural_params.split_chunk pairs, and the rest for the fused pass; a round of fewer than
-// neural_params.split_min_pairs pairs all for the fused pass; the pipelined split pass: its chunks'
-// dispatches) and counts queries for --stats.
+// neural_params.split_min_pairs pairs all for the fused pass) and counts queries for --stats.
 #version 460
 #include "lib/bindings.glsl"
 #include "lib/neural_bindings.glsl"
@@ -28,15 +27,4 @@ void main() {
     neural_counters.overflow_dispatch.x = (n - split + NB_NEURAL_GROUP - 1u) / NB_NEURAL_GROUP;
     neural_counters.overflow_dispatch.y = 1u;
     neural_counters.overflow_dispatch.z = 1u;
-    // The pipelined split pass: its workgroups in split_chunks chunks, each chunk's gather grid capped.
-    uint groups = neural_counters.split_dispatch.x;
-    uint chunks = clamp(neural_params.split_chunks, 1u, NB_SPLIT_MAX_CHUNKS);
-    uint per = (groups + chunks - 1u) / chunks;
-    neural_counters.split_chunk_groups = per;
-    for (uint c = 0u; c < NB_SPLIT_MAX_CHUNKS; ++c) {
-        uint first = min(c * per, groups);
-        uint count = min(per, groups - first);
-        neural_counters.split_gather_dispatch[c] = uvec4(min(count, max(neural_params.split_gather_groups, 1u)), 1u, 1u, 0u);
-        neural_counters.split_mlp_dispatch[c] = uvec4(count, 1u, 1u, 0u);
-    }
 }

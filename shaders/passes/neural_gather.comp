@@ -13,19 +13,11 @@
 
 layout(local_size_x = NB_NEURAL_GROUP) in;
 
-// The workgroups of chunk (pc.mode >> NB_QUERY_CHUNK_SHIFT) of the split pairs (neural_args: all of them
-// in chunk 0 where split_chunks is 1); a grid smaller than the chunk loops over it (the pipelined pass
-// caps it), its condition uniform over the workgroup.
 void main() {
-    uint per = neural_counters.split_chunk_groups;
-    uint first = ((pc.mode >> NB_QUERY_CHUNK_SHIFT) & (NB_SPLIT_MAX_CHUNKS - 1u)) * per;
-    uint end = min(first + per, neural_counters.split_dispatch.x);
-    for (uint g = first + gl_WorkGroupID.x; g < end; g += gl_NumWorkGroups.x) {
-        uint pair = g * NB_NEURAL_GROUP + gl_LocalInvocationID.x;
-        NbPendingQuery r = nb_load_pending(pair);
-        vec3 p0, p1, p2;
-        nb_segment_points(neural_params.box, r.org, r.dir, r.pl.t_enter, r.pl.t_exit, p0, p1, p2);
-        // Every lane gathers (the lane pairs shuffle), only valid pairs store.
-        NB_SPLIT_GATHER_STORE(pair, r.valid, p0, p1, p2)
-    }
+    uint pair = gl_GlobalInvocationID.x;
+    NbPendingQuery r = nb_load_pending(pair);
+    vec3 p0, p1, p2;
+    nb_segment_points(neural_params.box, r.org, r.dir, r.pl.t_enter, r.pl.t_exit, p0, p1, p2);
+    // Every lane gathers (the lane pairs shuffle), only valid pairs store.
+    NB_SPLIT_GATHER_STORE(pair, r.valid, p0, p1, p2)
 }

@@ -197,12 +197,8 @@ struct GpuNeuralParams {
     // Leaves queried per shadow ray at most, <= max_rounds (--neural-max-leaves-shadow; by default
     // max_rounds_secondary): shadow rays' truncation leaks or blocks light, path rays' changes paths.
     uint max_rounds_shadow;
-    // The split query pass pipelined (NB_SPLIT_MAX_CHUNKS, --neural-split-chunks): a round's split pairs
-    // in up to split_chunks chunks, chunk c's gather pass beside chunk c - 1's MLP pass; 1: one chunk.
-    uint split_chunks;
-    // Workgroups of a chunk's gather grid at most (it loops over its chunk; split_chunks > 1), so that
-    // the MLP pass beside it finds room on every SM.
-    uint split_gather_groups;
+    uint pad0;
+    uint pad1;
     uint pad2;
 };
 NB_STATIC_ASSERT(sizeof(GpuNeuralParams) == 112, "GpuNeuralParams layout");
@@ -241,11 +237,6 @@ NB_FN vec2 nb_node_fit_spread(vec2 fit, vec2 spread, uint random_bits) {
 // which the fused pass takes whole).
 #define NB_SPLIT_FEATURE_QUADS 24u // NB_SEGMENT_POINTS * NB_GRID_MAX_LEVELS, 8 bytes each
 #define NB_QUERY_MODE_OVERFLOW 16u // pass-constant mode bit of the fused query pass (bits 0-3: neural_traverse.glsl)
-// The pipelined split pass (GpuNeuralParams::split_chunks): at most this many chunks per round; the
-// gather and MLP passes find their chunk in pass-constant mode bits NB_QUERY_CHUNK_SHIFT.. (H200:
-// results/neural/README.md, the flat-list form in NeuralEvaluator).
-#define NB_SPLIT_MAX_CHUNKS 4u
-#define NB_QUERY_CHUNK_SHIFT 8u
 
 // The features buffer: each workgroup's NB_NEURAL_GROUP pairs own one contiguous block (12 KiB, so a
 // pair's features lie in one block; quad-major over the whole buffer put a pair's quads 174 MB apart in
@@ -277,9 +268,7 @@ struct GpuNeuralCounters {
     // First pair of the round the fused pass takes after the split pass (NB_QUERY_MODE_OVERFLOW),
     // written by passes/neural_args.comp: split_chunk, or 0 (a round below split_min_pairs).
     uint overflow_first;
-    // Workgroups of each chunk of the split pass (passes/neural_args.comp; the last chunks may be smaller
-    // or empty): chunk c takes the round's workgroups [c * split_chunk_groups, (c + 1) * ...).
-    uint split_chunk_groups;
+    uint pad1;
     uint pad2;
     // Statistics: queries per bounce of the path (index = depth, the last bucket also counting deeper
     // ones; as the ray counters of wavefront_gpu.h), 32-bit like the ray counters (read and
@@ -291,18 +280,11 @@ struct GpuNeuralCounters {
     // round below split_min_pairs), and of the rest through the fused pass.
     GpuDispatchArgs split_dispatch;
     GpuDispatchArgs overflow_dispatch;
-    // The pipelined split pass (GpuNeuralParams::split_chunks > 1): chunk c's gather and MLP dispatches
-    // (x, y, z; w unused), empty past the round's last chunk.
-    uvec4 split_gather_dispatch[NB_SPLIT_MAX_CHUNKS];
-    uvec4 split_mlp_dispatch[NB_SPLIT_MAX_CHUNKS];
 };
-NB_STATIC_ASSERT(sizeof(GpuNeuralCounters) == 32 + 4 * NB_STAT_DEPTHS + 24 + 32 * NB_SPLIT_MAX_CHUNKS,
-                 "GpuNeuralCounters layout");
-// Byte offsets of split_dispatch, overflow_dispatch and chunk c's dispatches (vkCmdDispatchIndirect).
+NB_STATIC_ASSERT(sizeof(GpuNeuralCounters) == 32 + 4 * NB_STAT_DEPTHS + 24, "GpuNeuralCounters layout");
+// Byte offsets of split_dispatch and overflow_dispatch (vkCmdDispatchIndirect).
 #define NB_NEURAL_SPLIT_DISPATCH_OFFSET (32u + 4u * NB_STAT_DEPTHS)
 #define NB_NEURAL_OVERFLOW_DISPATCH_OFFSET (NB_NEURAL_SPLIT_DISPATCH_OFFSET + 12u)
-#define NB_NEURAL_CHUNK_GATHER_OFFSET(c) (NB_NEURAL_OVERFLOW_DISPATCH_OFFSET + 12u + 16u * (c))
-#define NB_NEURAL_CHUNK_MLP_OFFSET(c) (NB_NEURAL_CHUNK_GATHER_OFFSET(NB_SPLIT_MAX_CHUNKS) + 16u * (c))
 
 // 64-bit counter (lo, hi) += n in 32-bit words (one writer at a time: passes/neural_args.comp).
 NB_FN void nb_add_u64(NB_INOUT(uint) lo, NB_INOUT(uint) hi, uint n) {

@@ -115,23 +115,19 @@
     F(lod_secondary)                                                                                         \
     F(roughness) F(metallic) F(threshold) F(max_rounds) F(leaves_per_round) F(occupancy) F(materials)        \
         F(material_fits) F(material_spread) F(split_chunk) F(split_min_pairs) F(max_rounds_secondary)        \
-            F(truncated_shadows_occlusion) F(leaves_per_round_camera) F(max_rounds_shadow) F(split_chunks) F(split_gather_groups) F(pad2)
+            F(truncated_shadows_occlusion) F(leaves_per_round_camera) F(max_rounds_shadow) F(pad0) F(pad1) F(pad2)
 #define NB_LAYOUT_FIELDS_GpuNeuralCounters(F)                                                                \
     F(pending_active)                                                                                        \
     F(queries_total)                                                                                         \
     F(leaf_cap_rays)                                                                                         \
     F(rounds)                                                                                                \
-    F(queries_total_hi) F(overflow_first) F(split_chunk_groups) F(pad2) F(queries_by_depth[0]) F(queries_by_depth[1])      \
+    F(queries_total_hi) F(overflow_first) F(pad1) F(pad2) F(queries_by_depth[0]) F(queries_by_depth[1])      \
         F(queries_by_depth[2]) F(queries_by_depth[3]) F(queries_by_depth[4]) F(queries_by_depth[5])          \
             F(queries_by_depth[6]) F(queries_by_depth[7]) F(queries_by_depth[8]) F(queries_by_depth[9])      \
                 F(queries_by_depth[10]) F(queries_by_depth[11]) F(queries_by_depth[12])                      \
                     F(queries_by_depth[13]) F(queries_by_depth[14]) F(queries_by_depth[15])                  \
                         F(split_dispatch.x) F(split_dispatch.y) F(split_dispatch.z) F(overflow_dispatch.x)   \
-                            F(overflow_dispatch.y) F(overflow_dispatch.z) F(split_gather_dispatch[0])        \
-                                F(split_gather_dispatch[1]) F(split_gather_dispatch[2])                      \
-                                    F(split_gather_dispatch[3]) F(split_mlp_dispatch[0])                     \
-                                        F(split_mlp_dispatch[1]) F(split_mlp_dispatch[2])                    \
-                                            F(split_mlp_dispatch[3])
+                            F(overflow_dispatch.y) F(overflow_dispatch.z)
 #define NB_LAYOUT_FIELDS_GpuNeuralAsset(F)                                                        \
     F(roots[0]) F(roots[1]) F(roots[2]) F(roots[3]) F(roots[4]) F(roots[5]) F(roots[6]) F(roots[7]) \
     F(material) F(metallic) F(roughness) F(backface_escape)
