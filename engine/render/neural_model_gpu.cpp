@@ -192,6 +192,7 @@ void record_pipelined(vk::CommandBuffer& cmd, const vk::ComputePipeline& gather,
                       const vk::ComputePipeline& mlp, vk::DescriptorSet& set, GpuNeuralEvalPush push,
                       uint32_t count, const NeuralEvaluator::Pipeline& p) {
     const uint32_t groups = (count + NB_NEURAL_GROUP - 1) / NB_NEURAL_GROUP;
+    if (groups == 0) return;
     const uint32_t per_chunk = (groups + p.chunks - 1) / p.chunks; // workgroups
     const uint32_t n = (groups + per_chunk - 1) / per_chunk;
     auto range = [&](uint32_t c) {
@@ -281,8 +282,9 @@ double NeuralEvaluator::time_dispatch(uint32_t count, int repetitions, float thr
     vk::GpuTimer timer(ctx_, 2 * std::max(1, repetitions) + 2);
     cmd.begin();
     if (timer.available()) timer.reset(cmd.handle());
-    // As many untimed dispatches first: the GPU's clock ramps up under load (H200: the first dispatches
-    // after the host's work ran at 1260-1440 instead of 1980 MHz, results/neural/README.md).
+    // As many untimed dispatches first: the GPU's clock ramps up under load (H200: the SM clock, sampled
+    // during a benchmark run, fell to 1260-1440 instead of 1980 MHz while the host compared results
+    // between rows; results/neural/README.md).
     const int total = repetitions > 1 ? 2 * repetitions : 1;
     for (int r = 0; r < total; ++r) {
         const bool timed = r >= total - std::max(1, repetitions);

@@ -108,6 +108,7 @@ int main(int argc, char** argv) try {
                 NeuralEvaluator::Pipeline pl;
                 pl.chunks = uint32_t(std::stoul(item.substr(0, colon)));
                 pl.groups = uint32_t(std::stoul(item.substr(colon + 1)));
+                if (pl.chunks == 0 || pl.groups == 0) throw Error("--pipeline wants C, G >= 1, got " + item);
                 pipelines.push_back(pl);
                 at = end + 1;
             }
