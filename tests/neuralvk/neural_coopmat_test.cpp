@@ -18,9 +18,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cstddef>
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <utility>
 
 using namespace nbvh;
 using namespace nbvh::render;
@@ -90,6 +92,19 @@ TEST(NeuralCoopmat, KernelsMatchFp16Reference) {
             for (size_t i = 0; i < a.size(); ++i) pdiffer += std::memcmp(&a[i], &c[i], sizeof(GpuNeuralHit)) != 0;
             EXPECT_EQ(pdiffer, 0u) << pl.chunks << " chunks, gather grids of " << pl.groups << ": of " << a.size()
                                    << " pipelined hits differ from the fused kernel's";
+        }
+        // Fewer workgroups than chunks (100 queries: 2 workgroups, 8 chunks) and a whole number of
+        // workgroups (320 queries, 5 chunks of one workgroup each, gather grids of one).
+        for (const auto& [n, pl] : {std::pair{size_t(100), NeuralEvaluator::Pipeline{8, 3}},
+                                    std::pair{size_t(320), NeuralEvaluator::Pipeline{5, 1}}}) {
+            const std::vector<GpuNeuralQuery> few(qs.begin(), qs.begin() + std::ptrdiff_t(n));
+            NeuralEvaluator piped(*ctx, gpu, choices[0], 6);
+            piped.set_pipeline(pl);
+            const std::vector<GpuNeuralHit> c = piped.evaluate(few);
+            ASSERT_EQ(c.size(), n);
+            size_t pdiffer = 0;
+            for (size_t i = 0; i < n; ++i) pdiffer += std::memcmp(&a[i], &c[i], sizeof(GpuNeuralHit)) != 0;
+            EXPECT_EQ(pdiffer, 0u) << n << " queries in " << pl.chunks << " chunks: pipelined hits differ";
         }
     }
     EXPECT_EQ(ctx->validation_message_count(), 0);
