@@ -127,11 +127,11 @@ public:
     // upload_queries() (timestamps; 0 without). For the benchmark.
     void upload_queries(const std::vector<GpuNeuralQuery>& queries);
     double time_dispatch(uint32_t count, int repetitions, float threshold = NB_VISIBILITY_THRESHOLD);
-    // Part 6, the split query pipelined: the queries in `chunks` chunks (fewer for few queries); each chunk's gather kernel is a
-    // grid of at most `groups` workgroups looping over the chunk (its residency capped, so that the
-    // previous chunk's MLP kernel, recorded after it with no barrier between them, finds room on every
-    // SM). The default (pipeline_for): 8 chunks, 6 workgroups per SM; one chunk (the plain split query)
-    // where the SM count is unknown. H200: results/neural/README.md.
+    // Part 6, the split query pipelined: the queries in `chunks` chunks (fewer for few queries); each
+    // chunk's gather kernel is a grid of at most `groups` workgroups looping over the chunk (its
+    // residency capped, so that the previous chunk's MLP kernel, recorded after it with no barrier
+    // between them, finds room on every SM). The default (pipeline_for): 8 chunks, 6 workgroups per SM;
+    // one chunk (the plain split query) where the SM count is unknown. H200: results/neural/README.md.
     struct Pipeline {
         uint32_t chunks = 1, groups = ~0u; // groups ~0u: uncapped
     };

@@ -14,7 +14,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <fstream>
 #include <random>
 #include <string>
@@ -163,8 +162,7 @@ int main(int argc, char** argv) try {
         r.qps = r.ms > 0 ? double(qs.size()) / (r.ms * 1e-3) : 0.0;
         std::printf("%-70s %9.3f ms / %zu queries = %.3f G queries/s\n", r.path.c_str(), r.ms, qs.size(),
                     r.qps * 1e-9);
-        for (size_t i = 0; i < qs.size(); ++i)
-            if (std::memcmp(&r.hits[i], &rows[1].hits[i], sizeof(GpuNeuralHit)) != 0) ++split_differs;
+        split_differs = test::differing_hits(rows[1].hits, r.hits);
         std::printf("split vs fused coopmat: %zu of %zu hits differ (bitwise)\n", split_differs, qs.size());
         const size_t split_row = rows.size();
         rows.push_back(std::move(r));
@@ -184,9 +182,7 @@ int main(int argc, char** argv) try {
             p.ms = pe.time_dispatch(uint32_t(qs.size()), reps);
             const double after = ev.time_dispatch(uint32_t(qs.size()), reps);
             p.qps = p.ms > 0 ? double(qs.size()) / (p.ms * 1e-3) : 0.0;
-            size_t differs = 0;
-            for (size_t i = 0; i < qs.size(); ++i)
-                if (std::memcmp(&p.hits[i], &rows[split_row].hits[i], sizeof(GpuNeuralHit)) != 0) ++differs;
+            const size_t differs = test::differing_hits(rows[split_row].hits, p.hits);
             std::printf("%-70s %9.3f ms / %zu queries = %.3f G queries/s (%zu hits differ from the split query; "
                         "the split query right before / after %.3f / %.3f ms)\n",
                         p.path.c_str(), p.ms, qs.size(), p.qps * 1e-9, differs, before, after);

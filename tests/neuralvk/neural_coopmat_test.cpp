@@ -20,7 +20,6 @@
 
 #include <cstddef>
 #include <cstdio>
-#include <cstring>
 #include <memory>
 #include <utility>
 
@@ -75,36 +74,24 @@ TEST(NeuralCoopmat, KernelsMatchFp16Reference) {
         NeuralEvaluator split(*ctx, gpu, choices[0], 3);
         const std::vector<GpuNeuralHit> a = fused.evaluate(qs), b = split.evaluate(qs);
         ASSERT_EQ(a.size(), b.size());
-        size_t differ = 0;
-        for (size_t i = 0; i < a.size(); ++i) differ += std::memcmp(&a[i], &b[i], sizeof(GpuNeuralHit)) != 0;
-        EXPECT_EQ(differ, 0u) << "of " << a.size() << " split hits differ from the fused kernel's";
+        EXPECT_EQ(test::differing_hits(a, b), 0u) << "of " << a.size() << " split hits differ from the fused kernel's";
         // Pipelined (part 6): chunks of whole workgroups with a partial last one, gather grids smaller
-        // and larger than a chunk's workgroups (the loop over the chunk, and no loop), and the device's
-        // default.
-        for (const NeuralEvaluator::Pipeline& pl :
-             {NeuralEvaluator::Pipeline{1, 1000}, NeuralEvaluator::Pipeline{3, 7}, NeuralEvaluator::Pipeline{7, 64},
-              NeuralEvaluator::pipeline_for(ctx->features())}) {
+        // and larger than a chunk's workgroups (the loop over the chunk, and no loop), the device's
+        // default; fewer workgroups than chunks (100 queries: 2 workgroups, 8 chunks) and a whole number
+        // of workgroups (320 queries, 5 chunks of one workgroup each, gather grids of one).
+        using Pipeline = NeuralEvaluator::Pipeline;
+        for (const auto& [n, pl] : {std::pair{qs.size(), Pipeline{1, 1000}}, std::pair{qs.size(), Pipeline{3, 7}},
+                                    std::pair{qs.size(), Pipeline{7, 64}},
+                                    std::pair{qs.size(), NeuralEvaluator::pipeline_for(ctx->features())},
+                                    std::pair{size_t(100), Pipeline{8, 3}}, std::pair{size_t(320), Pipeline{5, 1}}}) {
+            const std::vector<GpuNeuralQuery> some(qs.begin(), qs.begin() + std::ptrdiff_t(n));
             NeuralEvaluator piped(*ctx, gpu, choices[0], 6);
             piped.set_pipeline(pl);
-            const std::vector<GpuNeuralHit> c = piped.evaluate(qs);
-            ASSERT_EQ(c.size(), a.size());
-            size_t pdiffer = 0;
-            for (size_t i = 0; i < a.size(); ++i) pdiffer += std::memcmp(&a[i], &c[i], sizeof(GpuNeuralHit)) != 0;
-            EXPECT_EQ(pdiffer, 0u) << pl.chunks << " chunks, gather grids of " << pl.groups << ": of " << a.size()
-                                   << " pipelined hits differ from the fused kernel's";
-        }
-        // Fewer workgroups than chunks (100 queries: 2 workgroups, 8 chunks) and a whole number of
-        // workgroups (320 queries, 5 chunks of one workgroup each, gather grids of one).
-        for (const auto& [n, pl] : {std::pair{size_t(100), NeuralEvaluator::Pipeline{8, 3}},
-                                    std::pair{size_t(320), NeuralEvaluator::Pipeline{5, 1}}}) {
-            const std::vector<GpuNeuralQuery> few(qs.begin(), qs.begin() + std::ptrdiff_t(n));
-            NeuralEvaluator piped(*ctx, gpu, choices[0], 6);
-            piped.set_pipeline(pl);
-            const std::vector<GpuNeuralHit> c = piped.evaluate(few);
+            const std::vector<GpuNeuralHit> c = piped.evaluate(some);
             ASSERT_EQ(c.size(), n);
-            size_t pdiffer = 0;
-            for (size_t i = 0; i < n; ++i) pdiffer += std::memcmp(&a[i], &c[i], sizeof(GpuNeuralHit)) != 0;
-            EXPECT_EQ(pdiffer, 0u) << n << " queries in " << pl.chunks << " chunks: pipelined hits differ";
+            EXPECT_EQ(test::differing_hits(a, c), 0u)
+                << n << " queries in " << pl.chunks << " chunks, gather grids of " << pl.groups
+                << ": pipelined hits differ from the fused kernel's";
         }
     }
     EXPECT_EQ(ctx->validation_message_count(), 0);

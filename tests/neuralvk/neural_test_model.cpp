@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace nbvh::test {
 
@@ -98,6 +99,12 @@ CrossCheck cross_check(const TestModel& m, const std::vector<GpuNeuralQuery>& qs
         if (glm::length(nraw) > 0.05f) c.max_n = std::max(c.max_n, glm::length(h.normal - nb_decode_normal(y[2], y[3], y[4])));
     }
     return c;
+}
+
+size_t differing_hits(const std::vector<GpuNeuralHit>& a, const std::vector<GpuNeuralHit>& b) {
+    size_t n = 0;
+    for (size_t i = 0; i < b.size() && i < a.size(); ++i) n += std::memcmp(&a[i], &b[i], sizeof(GpuNeuralHit)) != 0;
+    return n;
 }
 
 } // namespace nbvh::test

@@ -48,4 +48,7 @@ struct CrossCheck {
 CrossCheck cross_check(const TestModel& m, const std::vector<GpuNeuralQuery>& qs,
                        const std::vector<GpuNeuralHit>& hits, float vis_margin);
 
+// Hits of `b` that differ bitwise from those of `a` at the same index (b no longer than a).
+size_t differing_hits(const std::vector<GpuNeuralHit>& a, const std::vector<GpuNeuralHit>& b);
+
 } // namespace nbvh::test
