@@ -228,9 +228,10 @@ int main(int argc, char** argv) try {
                 if (std::abs(a.visibility - NB_VISIBILITY_THRESHOLD) > 2e-3f) ++vis_diff_outside_margin;
             }
         }
-        const char* label = rows[k].path.rfind("split", 0) == 0 ? "split"
-                            : k == 1                            ? "coopmat"
-                                                                : "coopmat fp16-acc";
+        const char* label = rows[k].path.rfind("split pipelined", 0) == 0 ? "split pipelined"
+                            : rows[k].path.rfind("split", 0) == 0         ? "split"
+                            : k == 1                                      ? "coopmat"
+                                                                          : "coopmat fp16-acc";
         std::printf("scalar vs %s: max |dy| %.3g, mean |dy| %.3g, visibility differs on %zu of %zu (%zu with "
                     "|y0 - 0.5| > 2e-3), non-finite coopmat outputs %zu\n",
                     label, max_dy, sum_dy / double(qs.size()), vis_diff, qs.size(), vis_diff_outside_margin, nonfinite);
