@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "engine/bvh/wide_bvh.h"
+#include "engine/render/neural_grid_pack.h"
 #include "engine/render/neural_model_gpu.h"
 #include "shaders/shared/neural_gpu.h"
 #include "shaders/shared/scene_gpu.h"
@@ -28,8 +29,8 @@ uint64_t NeuralGpuBytes::total_for_lod(uint32_t lod) const {
 NeuralGpuBytes neural_gpu_bytes(const NeuralModel& model) {
     NeuralGpuBytes b;
     auto packed = [](size_t halves) { return uint64_t((halves + 1) / 2) * sizeof(uint32_t); }; // pack_halves
-    b.levels = uint64_t(model.levels.size()) * sizeof(uvec4); // packed (hashgrid.h nb_level_pack)
-    b.grid = packed(model.grid.size());
+    b.levels = uint64_t(model.levels.size() + 1) * sizeof(uvec4); // packed (hashgrid.h nb_level_pack) + y-pair word
+    b.grid = packed_grid_bytes(model);                           // with the y-pair table (neural_grid_pack.h)
     b.mlp = packed(model.mlp.size());
     b.mlp_transposed = b.mlp;
     std::vector<GpuBvhNode> nodes;

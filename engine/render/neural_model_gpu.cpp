@@ -5,6 +5,7 @@
 
 #include "engine/core/error.h"
 #include "engine/core/log.h"
+#include "engine/render/neural_grid_pack.h"
 #include "engine/vk/commands.h"
 #include "shaders/shared/mlp.h"
 #include "shaders/shared/neural_occupancy.h"
@@ -135,8 +136,10 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
         throw Error("the model has no network or no N-BVH");
     std::vector<uvec4> packed_levels;
     for (const GpuHashLevel& l : model.levels) packed_levels.push_back(nb_level_pack(l)); // neural_grid.glsl
+    const PackedGrid grid = pack_grid(model);
+    packed_levels.push_back(ypair_word(grid)); // NB_LEVEL_YPAIR_WORD
     levels_ = vk::make_buffer(ctx, packed_levels, "neural levels");
-    grid_ = vk::make_buffer(ctx, pack_halves(model.grid), "neural grid");
+    grid_ = vk::make_buffer(ctx, grid.words, "neural grid");
     mlp_ = vk::make_buffer(ctx, pack_halves(model.mlp), "neural mlp");
     mlp_t_ = vk::make_buffer(ctx, pack_halves(transpose_mlp(model.mlp)), "neural mlp transposed");
     std::vector<GpuBvhNode> nodes;

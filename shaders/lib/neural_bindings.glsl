@@ -10,6 +10,10 @@
 
 layout(set = 0, binding = NB_BIND_NEURAL_LEVELS, std430) readonly buffer NeuralLevelBuffer { uvec4 neural_levels[]; }; // GpuHashLevel (lib/neural_grid.glsl)
 layout(set = 0, binding = NB_BIND_NEURAL_GRID, scalar) readonly buffer NeuralGridBuffer { uvec2 neural_grid[]; };
+#ifdef NB_GATHER_YPAIR
+// The same buffer in 16-byte words, for the y-pair table after the entries (shared/hashgrid.h).
+layout(set = 0, binding = NB_BIND_NEURAL_GRID, std430) readonly buffer NeuralGridPairs { uvec4 neural_grid_y[]; };
+#endif
 #ifdef NB_NEURAL_MLP_AS_TILES
 layout(set = 0, binding = NB_BIND_NEURAL_MLP_T, std430) readonly buffer NeuralMlpBuffer { uvec4 neural_mlp_tiles[]; };
 #else

@@ -11,6 +11,10 @@
 layout(push_constant, scalar) uniform EvalPushBlock { GpuNeuralEvalPush pc; };
 layout(set = 0, binding = NB_NEVAL_BIND_LEVELS, std430) readonly buffer LevelBuffer { uvec4 neural_levels[]; }; // GpuHashLevel
 layout(set = 0, binding = NB_NEVAL_BIND_GRID, scalar) readonly buffer GridBuffer { uvec2 neural_grid[]; };
+#ifdef NB_GATHER_YPAIR
+// The same buffer in 16-byte words, for the y-pair table after the entries (shared/hashgrid.h).
+layout(set = 0, binding = NB_NEVAL_BIND_GRID, std430) readonly buffer GridPairs { uvec4 neural_grid_y[]; };
+#endif
 layout(set = 0, binding = NB_NEVAL_BIND_QUERIES, scalar) readonly buffer QueryBuffer { GpuNeuralQuery queries[]; };
 layout(set = 0, binding = NB_NEVAL_BIND_HITS, scalar) writeonly buffer HitBuffer { GpuNeuralHit hits[]; };
 

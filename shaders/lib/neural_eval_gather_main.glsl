@@ -3,6 +3,7 @@
 // fp16 quads (point-major, then level) to the features buffer as its tile rows (shared/neural_gpu.h);
 // passes/neural_eval_mlp32.comp runs the MLP on them. For the benchmark and tests.
 #define NB_COOP_ACC_BITS 32 // the paired-lane gather of lib/neural_grid.glsl
+#define NB_GATHER_YPAIR 1 // the y-pair loads of the dense levels (lib/neural_grid.glsl)
 #include "lib/neural_eval_common.glsl"
 layout(set = 0, binding = NB_NEVAL_BIND_FEATURES, std430) writeonly buffer FeatureTiles { uvec4 split_feature_tiles[]; };
 #include "lib/neural_grid.glsl"

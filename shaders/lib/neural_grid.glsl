@@ -27,11 +27,23 @@ vec4 nb_neural_level_features(vec3 p, uint l) {
     uvec3 cell;
     vec3 frac;
     nb_grid_position(lv, p, cell, frac);
+    uvec2 e[NB_GRID_CORNERS];
+#ifdef NB_GATHER_YPAIR
+    uvec4 yp = neural_levels[NB_LEVEL_YPAIR_WORD]; // (table base, y-paired levels, 0, 0)
+    if (l < yp.y) {
+        // Corners c and c|2 in one load (shared/hashgrid.h y-pair table); the same words.
+        for (uint c = 0u; c < NB_GRID_CORNERS; c += (c & 1u) != 0u ? 3u : 1u) { // 0, 1, 4, 5
+            uvec4 t = neural_grid_y[yp.x + nb_grid_corner_entry(lv, cell, c)];
+            e[c] = t.xy;
+            e[c + 2u] = t.zw;
+        }
+    } else
+#endif
+    for (uint c = 0u; c < NB_GRID_CORNERS; ++c) e[c] = neural_grid[nb_grid_corner_entry(lv, cell, c)];
     vec4 sum = vec4(0.0f);
     for (uint c = 0u; c < NB_GRID_CORNERS; ++c) {
         float w = nb_grid_corner_weight(frac, c);
-        uvec2 e = neural_grid[nb_grid_corner_entry(lv, cell, c)];
-        vec4 v = vec4(unpackHalf2x16(e.x), unpackHalf2x16(e.y));
+        vec4 v = vec4(unpackHalf2x16(e[c].x), unpackHalf2x16(e[c].y));
         // Separate multiply and add per component, in corner order (the CPU reference's order).
         sum.x += w * v.x;
         sum.y += w * v.y;
@@ -64,6 +76,55 @@ vec4 nb_neural_level_features(vec3 p, uint l) {
 // sum(even corners) + sum(odd corners), rounded once to fp16 (R1). That order differs from the
 // reference's 0..7 chain, so a feature can differ by one fp16 ulp from the CPU reference (the coopmat
 // MLP sums in another order too; tests/neuralvk bounds both). All 32 lanes must be active (shuffles).
+// The paired lanes' sums of the loaded corners (see nb_neural_levels_paired): each lane's 4 corners of
+// both queries in corner order, then the partner's partial of its own query.
+void nb_neural_paired_sums(uvec2 ea[NB_GATHER_LEVELS * 4u], uvec2 eb[NB_GATHER_LEVELS * 4u], vec3 fa[NB_GATHER_LEVELS],
+                           vec3 fb[NB_GATHER_LEVELS], uint xbit, out vec4 f[NB_GATHER_LEVELS]) {
+    [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g) {
+        vec4 sa = vec4(0.0f);
+        vec4 sb = vec4(0.0f);
+        [[unroll]] for (uint j = 0u; j < 4u; ++j) {
+            uvec2 xa = ea[g * 4u + j];
+            uvec2 xb = eb[g * 4u + j];
+            sa += nb_grid_corner_weight(fa[g], 2u * j + xbit) * vec4(unpackHalf2x16(xa.x), unpackHalf2x16(xa.y));
+            sb += nb_grid_corner_weight(fb[g], 2u * j + xbit) * vec4(unpackHalf2x16(xb.x), unpackHalf2x16(xb.y));
+        }
+        // The even lane owns query a, the odd lane query b: each sends the partial of its partner's query.
+        vec4 other = subgroupShuffleXor(xbit == 0u ? sb : sa, 1u);
+        vec4 sum = (xbit == 0u ? sa : sb) + other; // even + odd in both lanes (addition commutes exactly)
+        f[g] = vec4(nb_round_half(sum.x), nb_round_half(sum.y), nb_round_half(sum.z), nb_round_half(sum.w));
+    }
+}
+
+#ifdef NB_GATHER_YPAIR
+// nb_neural_levels_paired for a batch of levels that all have y-pair entries (shared/hashgrid.h; the
+// includer declares `uvec4 neural_grid_y[]` on the grid's binding): corners 2j + xbit and 2j + 2 + xbit
+// (j = 0, 2: z and z + 1) in one 16-byte load, half the loads and lines; the same words, so the same sums.
+void nb_neural_levels_paired_y(vec3 p_even, vec3 p_odd, uint l0, uint xbit, uint ybase, out vec4 f[NB_GATHER_LEVELS]) {
+    for (uint once = 0u; once < 1u; ++once) { // (see below)
+        uvec2 ea[NB_GATHER_LEVELS * 4u];
+        uvec2 eb[NB_GATHER_LEVELS * 4u];
+        vec3 fa[NB_GATHER_LEVELS];
+        vec3 fb[NB_GATHER_LEVELS];
+        [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g) {
+            GpuHashLevel lv = nb_neural_level(l0 + g);
+            uvec3 ca, cb;
+            nb_grid_position(lv, p_even, ca, fa[g]);
+            nb_grid_position(lv, p_odd, cb, fb[g]);
+            [[unroll]] for (uint j = 0u; j < 4u; j += 2u) {
+                uvec4 a = neural_grid_y[ybase + nb_grid_corner_entry(lv, ca, 2u * j + xbit)];
+                uvec4 b = neural_grid_y[ybase + nb_grid_corner_entry(lv, cb, 2u * j + xbit)];
+                ea[g * 4u + j] = a.xy;
+                ea[g * 4u + j + 1u] = a.zw;
+                eb[g * 4u + j] = b.xy;
+                eb[g * 4u + j + 1u] = b.zw;
+            }
+        }
+        nb_neural_paired_sums(ea, eb, fa, fb, xbit, f);
+    }
+}
+#endif
+
 void nb_neural_levels_paired(vec3 p_even, vec3 p_odd, uint l0, uint xbit, out vec4 f[NB_GATHER_LEVELS]) {
     // A loop of ONE iteration on purpose: the same code without it (straight-line) ran 0.43 instead of
     // 0.57 G queries/s in the v15 kernel (results/neural/README.md), presumably because the driver then
@@ -83,20 +144,7 @@ void nb_neural_levels_paired(vec3 p_even, vec3 p_odd, uint l0, uint xbit, out ve
                 eb[g * 4u + j] = neural_grid[nb_grid_corner_entry(lv, cb, 2u * j + xbit)];
             }
         }
-        [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g) {
-            vec4 sa = vec4(0.0f);
-            vec4 sb = vec4(0.0f);
-            [[unroll]] for (uint j = 0u; j < 4u; ++j) {
-                uvec2 xa = ea[g * 4u + j];
-                uvec2 xb = eb[g * 4u + j];
-                sa += nb_grid_corner_weight(fa[g], 2u * j + xbit) * vec4(unpackHalf2x16(xa.x), unpackHalf2x16(xa.y));
-                sb += nb_grid_corner_weight(fb[g], 2u * j + xbit) * vec4(unpackHalf2x16(xb.x), unpackHalf2x16(xb.y));
-            }
-            // The even lane owns query a, the odd lane query b: each sends the partial of its partner's query.
-            vec4 other = subgroupShuffleXor(xbit == 0u ? sb : sa, 1u);
-            vec4 sum = (xbit == 0u ? sa : sb) + other; // even + odd in both lanes (addition commutes exactly)
-            f[g] = vec4(nb_round_half(sum.x), nb_round_half(sum.y), nb_round_half(sum.z), nb_round_half(sum.w));
-        }
+        nb_neural_paired_sums(ea, eb, fa, fb, xbit, f);
     }
 }
 
@@ -118,6 +166,20 @@ uvec2 nb_split_quad(vec4 f) { return uvec2(packHalf2x16(f.xy), packHalf2x16(f.zw
         })                                                                                            \
     }
 
+// One batch of levels through the y-pair table where every level of the batch has one.
+#ifdef NB_GATHER_YPAIR
+#define NB_PAIRED_LEVELS(PE, PO, L0, XBIT, F)                                                         \
+    {                                                                                                 \
+        uvec4 yp_ = neural_levels[NB_LEVEL_YPAIR_WORD]; /* (table base, y-paired levels, 0, 0) */     \
+        if ((L0) + NB_GATHER_LEVELS <= yp_.y)                                                         \
+            nb_neural_levels_paired_y(PE, PO, L0, XBIT, yp_.x, F);                                    \
+        else                                                                                          \
+            nb_neural_levels_paired(PE, PO, L0, XBIT, F);                                             \
+    }
+#else
+#define NB_PAIRED_LEVELS(PE, PO, L0, XBIT, F) nb_neural_levels_paired(PE, PO, L0, XBIT, F);
+#endif
+
 // Runs BODY for every (point k, level l) of a segment's 3 points with `vec4 f` = that level's 4
 // features (fp16-rounded), through the paired-lane gather, NB_GATHER_LEVELS levels of a point at a
 // time (the fused query kernels stage f in shared memory, the split query's gather pass stores it).
@@ -132,7 +194,7 @@ uvec2 nb_split_quad(vec4 f) { return uvec2(packHalf2x16(f.xy), packHalf2x16(f.zw
             vec3 p_odd_ = xbit_ == 0u ? partner_ : p_;                                                \
             for (uint l0_ = 0u; l0_ < NB_GRID_MAX_LEVELS; l0_ += NB_GATHER_LEVELS) {                  \
                 vec4 fs_[NB_GATHER_LEVELS];                                                           \
-                nb_neural_levels_paired(p_even_, p_odd_, l0_, xbit_, fs_);                            \
+                NB_PAIRED_LEVELS(p_even_, p_odd_, l0_, xbit_, fs_);                                   \
                 [[unroll]] for (uint g_ = 0u; g_ < NB_GATHER_LEVELS; ++g_) {                          \
                     uint l = l0_ + g_;                                                                \
                     vec4 f = fs_[g_];                                                                 \

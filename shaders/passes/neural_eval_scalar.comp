@@ -1,6 +1,10 @@
 // Neural queries of a flat list, scalar fp16 path (lib/neural_mlp_scalar.glsl): one query per
 // invocation. Runs on every Vulkan 1.2 device; makes no assumption on the subgroup size.
 #version 460
+// The dense levels' corners through the y-pair table (shared/hashgrid.h), as the split query's gather
+// reads them: the lavapipe cross-check against the CPU reference covers the table (its contents and
+// indexing), which the GPU gather kernels need a subgroup size of 32 to run.
+#define NB_GATHER_YPAIR 1
 #include "lib/neural_eval_common.glsl"
 layout(set = 0, binding = NB_NEVAL_BIND_MLP, scalar) readonly buffer MlpBuffer { uint neural_mlp[]; };
 #include "lib/neural_grid.glsl"

@@ -5,6 +5,7 @@
 #version 460
 #define NB_COOP_ACC_BITS 32 // the paired-lane gather of lib/neural_grid.glsl
 #define NB_SPLIT_FEATURES 1
+#define NB_GATHER_YPAIR 1 // the y-pair loads of the dense levels (lib/neural_grid.glsl)
 #define NB_SPLIT_FEATURES_ACCESS writeonly
 #include "lib/bindings.glsl"
 #include "lib/neural_bindings.glsl"

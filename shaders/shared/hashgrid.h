@@ -72,6 +72,19 @@ NB_FN GpuHashLevel nb_level_unpack(uvec4 w) {
 }
 #endif
 
+// Y-pair table (GPU only, engine/render/neural_grid_pack.h builds it when a model is uploaded; the model
+// file does not change). In a dense level whose size is a power of two, the +y neighbour of the vertex
+// at index i is at (i + res) % size, whatever the wrapping of the row-major index (size divides 2^32):
+// the table's entry i of such a level holds the level's entries i and (i + res) % size, 16 bytes, so the
+// corners c and c|2 of a cell come in one load. It covers the leading levels that qualify (levels are
+// ordered coarse to fine: the dense ones first) and is indexed like the entries (level offset + index),
+// from the 16-byte word given by the level buffer's extension word NB_LEVEL_YPAIR_WORD = (base,
+// levels, 0, 0). Same words as the plain entries, so the same features to the bit.
+#define NB_LEVEL_YPAIR_WORD NB_GRID_MAX_LEVELS
+NB_FN bool nb_level_ypair_ok(GpuHashLevel l) { return l.hashed == 0u && l.size != 0u && (l.size & (l.size - 1u)) == 0u; }
+// Index (within the level) of the +y neighbour of the vertex at index i of a qualifying level.
+NB_FN uint nb_grid_ypair_partner(GpuHashLevel l, uint i) { return (i + l.resolution) & (l.size - 1u); }
+
 // fma as tcnn's pos_fract uses it (fmaf). GLSL's fma is only guaranteed fused under `precise`;
 // without it the result may differ by one float rounding, which moves a cell only when
 // x*scale + 0.5 lands within 1 ulp of an integer.

@@ -11,6 +11,7 @@
 #include "engine/bvh/scene_accel.h"
 #include "engine/core/error.h"
 #include "engine/neural/asset_table.h"
+#include "engine/render/neural_grid_pack.h"
 #include "engine/render/neural_model_gpu.h"
 #include "engine/render/neural_stage.h"
 #include "engine/render/wavefront.h"
@@ -92,10 +93,13 @@ TEST(SplitQuery, SameImageAsTheFusedPass) {
     opt.steps = 200;
     opt.batch_size = 2048;
     opt.target_nodes = 120;
-    opt.network.log2_hash_size = 14;
+    // 2^18 (the default): levels 0-3 are dense with power-of-two sizes, so the gather pass reads the first
+    // batch of levels through the y-pair table (shared/hashgrid.h) and the fused pass the plain entries.
+    opt.network.log2_hash_size = 18;
     auto backend = make_backend(BackendChoice::cpu, asset, opt);
     const NeuralModel model =
         make_neural_model(asset, train_asset(asset, opt, *backend), opt, "split_query_test", 0);
+    ASSERT_EQ(ypair_level_count(model.levels), 4u); // the gather's first batch of 4 levels is y-paired
 
     const Scene scene = make_scene();
     const SceneAccel accel = build_scene_accel(scene);
