@@ -96,56 +96,51 @@ void nb_neural_paired_sums(uvec2 ea[NB_GATHER_LEVELS * 4u], uvec2 eb[NB_GATHER_L
     }
 }
 
+// The body of nb_neural_levels_paired and its y-pair form: each level g of the batch's cells (ca, cb)
+// and fractions of both queries, then LOAD (ea and eb [g * 4 .. g * 4 + 3]: the lane's 4 corners of each
+// query), then the sums. Each form instantiates it whole: a form that chose the loads per batch and then
+// summed once took the gather kernel from 56 to 127 registers (the loaded words merged from the two
+// paths; results/neural/ypair_variants_h200.txt).
+// A loop of ONE iteration on purpose: the same code without it (straight-line) ran 0.43 instead of 0.57 G
+// queries/s in the v15 kernel (results/neural/README.md), presumably because the driver then schedules the
+// level loop around it differently (more registers, fewer resident warps).
+#define NB_PAIRED_LEVELS_BODY(LOAD)                                                                   \
+    for (uint once = 0u; once < 1u; ++once) {                                                         \
+        uvec2 ea[NB_GATHER_LEVELS * 4u];                                                              \
+        uvec2 eb[NB_GATHER_LEVELS * 4u];                                                              \
+        vec3 fa[NB_GATHER_LEVELS];                                                                    \
+        vec3 fb[NB_GATHER_LEVELS];                                                                    \
+        [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g) {                                     \
+            GpuHashLevel lv = nb_neural_level(l0 + g);                                                \
+            uvec3 ca, cb;                                                                             \
+            nb_grid_position(lv, p_even, ca, fa[g]);                                                  \
+            nb_grid_position(lv, p_odd, cb, fb[g]);                                                   \
+            LOAD                                                                                      \
+        }                                                                                             \
+        nb_neural_paired_sums(ea, eb, fa, fb, xbit, f);                                               \
+    }
+
 #ifdef NB_GATHER_YPAIR
 // nb_neural_levels_paired for a batch of levels that all have y-pair entries (shared/hashgrid.h; the
 // includer declares `uvec4 neural_grid_y[]` on the grid's binding): corners 2j + xbit and 2j + 2 + xbit
 // (j = 0, 2: z and z + 1) in one 16-byte load, half the loads and lines; the same words, so the same sums.
 void nb_neural_levels_paired_y(vec3 p_even, vec3 p_odd, uint l0, uint xbit, uint ybase, out vec4 f[NB_GATHER_LEVELS]) {
-    for (uint once = 0u; once < 1u; ++once) { // (see below)
-        uvec2 ea[NB_GATHER_LEVELS * 4u];
-        uvec2 eb[NB_GATHER_LEVELS * 4u];
-        vec3 fa[NB_GATHER_LEVELS];
-        vec3 fb[NB_GATHER_LEVELS];
-        [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g) {
-            GpuHashLevel lv = nb_neural_level(l0 + g);
-            uvec3 ca, cb;
-            nb_grid_position(lv, p_even, ca, fa[g]);
-            nb_grid_position(lv, p_odd, cb, fb[g]);
-            [[unroll]] for (uint j = 0u; j < 4u; j += 2u) {
-                uvec4 a = neural_grid_y[ybase + nb_grid_corner_entry(lv, ca, 2u * j + xbit)];
-                uvec4 b = neural_grid_y[ybase + nb_grid_corner_entry(lv, cb, 2u * j + xbit)];
-                ea[g * 4u + j] = a.xy;
-                ea[g * 4u + j + 1u] = a.zw;
-                eb[g * 4u + j] = b.xy;
-                eb[g * 4u + j + 1u] = b.zw;
-            }
-        }
-        nb_neural_paired_sums(ea, eb, fa, fb, xbit, f);
-    }
+    NB_PAIRED_LEVELS_BODY([[unroll]] for (uint j = 0u; j < 4u; j += 2u) {
+        uvec4 a = neural_grid_y[ybase + nb_grid_corner_entry(lv, ca, 2u * j + xbit)];
+        uvec4 b = neural_grid_y[ybase + nb_grid_corner_entry(lv, cb, 2u * j + xbit)];
+        ea[g * 4u + j] = a.xy;
+        ea[g * 4u + j + 1u] = a.zw;
+        eb[g * 4u + j] = b.xy;
+        eb[g * 4u + j + 1u] = b.zw;
+    })
 }
 #endif
 
 void nb_neural_levels_paired(vec3 p_even, vec3 p_odd, uint l0, uint xbit, out vec4 f[NB_GATHER_LEVELS]) {
-    // A loop of ONE iteration on purpose: the same code without it (straight-line) ran 0.43 instead of
-    // 0.57 G queries/s in the v15 kernel (results/neural/README.md), presumably because the driver then
-    // schedules the level loop around it differently (more registers, fewer resident warps).
-    for (uint once = 0u; once < 1u; ++once) {
-        uvec2 ea[NB_GATHER_LEVELS * 4u];
-        uvec2 eb[NB_GATHER_LEVELS * 4u];
-        vec3 fa[NB_GATHER_LEVELS];
-        vec3 fb[NB_GATHER_LEVELS];
-        [[unroll]] for (uint g = 0u; g < NB_GATHER_LEVELS; ++g) {
-            GpuHashLevel lv = nb_neural_level(l0 + g);
-            uvec3 ca, cb;
-            nb_grid_position(lv, p_even, ca, fa[g]);
-            nb_grid_position(lv, p_odd, cb, fb[g]);
-            [[unroll]] for (uint j = 0u; j < 4u; ++j) {
-                ea[g * 4u + j] = neural_grid[nb_grid_corner_entry(lv, ca, 2u * j + xbit)];
-                eb[g * 4u + j] = neural_grid[nb_grid_corner_entry(lv, cb, 2u * j + xbit)];
-            }
-        }
-        nb_neural_paired_sums(ea, eb, fa, fb, xbit, f);
-    }
+    NB_PAIRED_LEVELS_BODY([[unroll]] for (uint j = 0u; j < 4u; ++j) {
+        ea[g * 4u + j] = neural_grid[nb_grid_corner_entry(lv, ca, 2u * j + xbit)];
+        eb[g * 4u + j] = neural_grid[nb_grid_corner_entry(lv, cb, 2u * j + xbit)];
+    })
 }
 
 // A level's 4 features (already fp16 values) as one 8-byte quad of the split query's features buffer.
