@@ -85,10 +85,10 @@ void print_model(const std::string& path) {
     // Every GPU buffer a hybrid render holds for the model (engine/render/gpu_memory.h).
     const render::NeuralGpuBytes b = render::neural_gpu_bytes(m);
     const uint64_t neural = b.total();
-    std::printf("memory       %s on the GPU (grid %s, mlp %s + its transposed copy, nodes of %zu LoD(s) %s + bounds "
+    std::printf("memory       %s on the GPU (grid %s + its y-pair copy %s, mlp %s + its transposed copy, nodes of %zu LoD(s) %s + bounds "
                 "%s, occupancy masks %s, node materials %s, level table %s, asset table %s); with LoD 0 alone %s\n",
                 human_bytes(double(neural)).c_str(), human_bytes(double(b.grid)).c_str(),
-                human_bytes(double(b.mlp)).c_str(), b.lod_nodes.size(), human_bytes(double(b.nodes)).c_str(),
+                human_bytes(double(b.grid_ypair)).c_str(), human_bytes(double(b.mlp)).c_str(), b.lod_nodes.size(), human_bytes(double(b.nodes)).c_str(),
                 human_bytes(double(b.node_bounds)).c_str(),
                 b.occupancy ? human_bytes(double(b.occupancy)).c_str() : "none (model before format version 3)",
                 b.materials ? (human_bytes(double(b.materials)) + (m.material_fits.empty() ? " (means; fits from format version 5)"

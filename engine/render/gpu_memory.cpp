@@ -30,7 +30,11 @@ NeuralGpuBytes neural_gpu_bytes(const NeuralModel& model) {
     NeuralGpuBytes b;
     auto packed = [](size_t halves) { return uint64_t((halves + 1) / 2) * sizeof(uint32_t); }; // pack_halves
     b.levels = uint64_t(model.levels.size() + 1) * sizeof(uvec4); // packed (hashgrid.h nb_level_pack) + y-pair word
-    b.grid = packed_grid_bytes(model);                           // with the y-pair table (neural_grid_pack.h)
+    // The grid buffer (neural_grid_pack.h): the entries, and the y-pair table apart. Without a device the
+    // table is taken whole (a device whose storage-buffer bindings are smaller gets less of it).
+    const GridLayout grid = grid_layout(model);
+    b.grid = grid.entry_bytes;
+    b.grid_ypair = grid.ypair_bytes;
     b.mlp = packed(model.mlp.size());
     b.mlp_transposed = b.mlp;
     std::vector<GpuBvhNode> nodes;

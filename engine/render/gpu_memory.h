@@ -23,6 +23,7 @@ uint64_t mesh_gpu_bytes(const Mesh& mesh); // builds the BLAS with default_blas_
 // the wave size, not with the model.
 struct NeuralGpuBytes {
     uint64_t levels = 0, grid = 0, mlp = 0, mlp_transposed = 0; // the transposed copy feeds coopmat kernels
+    uint64_t grid_ypair = 0;         // the y-pair copy of the dense levels, for the split gather (neural_grid_pack.h)
     uint64_t nodes = 0;              // N-BVH nodes of every LoD and asset (GpuBvhNode)
     std::vector<uint64_t> lod_nodes; // ... of each LoD alone
     uint64_t node_bounds = 0;        // NB_NBVH_BOUNDS_WORDS per N-BVH node (two 16-byte words)
@@ -30,7 +31,8 @@ struct NeuralGpuBytes {
     uint64_t materials = 0;          // one word per N-BVH node (0: the model has no node materials)
     uint64_t assets = 0, params = 0; // GpuNeuralAsset table, GpuNeuralParams
     uint64_t total() const {
-        return levels + grid + mlp + mlp_transposed + nodes + node_bounds + occupancy + materials + assets + params;
+        return levels + grid + grid_ypair + mlp + mlp_transposed + nodes + node_bounds + occupancy + materials + assets +
+               params;
     }
     // A model that keeps only the cut of `lod` (the others' nodes not uploaded).
     uint64_t total_for_lod(uint32_t lod) const;

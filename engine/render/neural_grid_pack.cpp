@@ -16,39 +16,47 @@ uint32_t ypair_level_count(const std::vector<GpuHashLevel>& levels) {
 }
 
 namespace {
-uint32_t ypair_entries_of(const std::vector<GpuHashLevel>& levels, uint32_t count) {
-    return count == 0 ? 0u : levels[count - 1].offset + levels[count - 1].size;
+uint64_t ypair_entries_of(const std::vector<GpuHashLevel>& levels, uint32_t count) {
+    return count == 0 ? 0u : uint64_t(levels[count - 1].offset) + levels[count - 1].size;
 }
-uint64_t entry_words(const NeuralModel& model) { return (uint64_t(model.grid.size()) + 1) / 2; }
 } // namespace
 
-PackedGrid pack_grid(const NeuralModel& model) {
-    PackedGrid g;
-    g.words = pack_halves(model.grid);
-    g.ypair_levels = ypair_level_count(model.levels);
-    g.ypair_entries = ypair_entries_of(model.levels, g.ypair_levels);
-    if (uint64_t(g.ypair_entries) * NB_GRID_FEATURES > model.grid.size())
+GridLayout grid_layout(const NeuralModel& model, uint64_t max_bytes) {
+    GridLayout g;
+    g.entry_bytes = (uint64_t(model.grid.size()) * 2 + 15) / 16 * 16; // fp16 halves, padded to 16 bytes
+    uint32_t levels = ypair_level_count(model.levels);
+    uint64_t entries = ypair_entries_of(model.levels, levels);
+    // The table covers entries the grid holds (the level table of a loaded file is validated against it;
+    // an inconsistent in-memory model is refused, never read past its end).
+    if (entries * NB_GRID_FEATURES > model.grid.size())
         throw Error("the model's hash grid is smaller than its level table says");
-    g.words.resize((g.words.size() + 3) / 4 * 4, 0u); // the table starts on a 16-byte word
+    while (levels > 0 && g.entry_bytes + entries * 16 > max_bytes) entries = ypair_entries_of(model.levels, --levels);
+    g.ypair_levels = levels;
+    g.ypair_entries = uint32_t(entries); // <= the grid's entries: a level holds at most 2^24, 8 levels
+    g.ypair_bytes = entries * 16;
+    return g;
+}
+
+PackedGrid pack_grid(const NeuralModel& model, uint64_t max_bytes) {
+    const GridLayout layout = grid_layout(model, max_bytes);
+    PackedGrid g;
+    g.ypair_levels = layout.ypair_levels;
+    g.ypair_entries = layout.ypair_entries;
+    g.words = pack_halves(model.grid);
+    g.words.reserve((layout.entry_bytes + layout.ypair_bytes) / 4);
+    g.words.resize(layout.entry_bytes / 4, 0u); // the table starts on a 16-byte word
     g.ypair_base = uint32_t(g.words.size() / 4);
-    std::vector<uint32_t> table;
-    table.reserve(size_t(g.ypair_entries) * 4);
     for (uint32_t l = 0; l < g.ypair_levels; ++l) {
         const GpuHashLevel& lv = model.levels[l];
         for (uint32_t i = 0; i < lv.size; ++i) {
-            const size_t a = lv.offset + i, b = lv.offset + nb_grid_ypair_partner(lv, i);
-            table.insert(table.end(), {g.words[2 * a], g.words[2 * a + 1], g.words[2 * b], g.words[2 * b + 1]});
+            const size_t a = size_t(lv.offset) + i, b = size_t(lv.offset) + nb_grid_ypair_partner(lv, i);
+            const uint32_t w[4] = {g.words[2 * a], g.words[2 * a + 1], g.words[2 * b], g.words[2 * b + 1]};
+            g.words.insert(g.words.end(), w, w + 4); // within the reserved size: no reallocation
         }
     }
-    g.words.insert(g.words.end(), table.begin(), table.end());
     return g;
 }
 
 uvec4 ypair_word(const PackedGrid& grid) { return uvec4(grid.ypair_base, grid.ypair_levels, 0u, 0u); }
-
-uint64_t packed_grid_bytes(const NeuralModel& model) {
-    const uint64_t ypair = ypair_entries_of(model.levels, ypair_level_count(model.levels));
-    return ((entry_words(model) + 3) / 4 + ypair) * 16u;
-}
 
 } // namespace nbvh::render

@@ -136,7 +136,7 @@ NeuralModelGpu::NeuralModelGpu(const vk::Context& ctx, const NeuralModel& model)
         throw Error("the model has no network or no N-BVH");
     std::vector<uvec4> packed_levels;
     for (const GpuHashLevel& l : model.levels) packed_levels.push_back(nb_level_pack(l)); // neural_grid.glsl
-    const PackedGrid grid = pack_grid(model);
+    const PackedGrid grid = pack_grid(model, ctx.features().max_storage_buffer_range); // one binding
     packed_levels.push_back(ypair_word(grid)); // NB_LEVEL_YPAIR_WORD
     levels_ = vk::make_buffer(ctx, packed_levels, "neural levels");
     grid_ = vk::make_buffer(ctx, grid.words, "neural grid");

@@ -4,8 +4,10 @@
 // corners 0..7, one rounding to fp16 per level and feature.
 //
 // The including shader declares (any binding):
-//   uvec4 neural_levels[];         // std430: NB_GRID_MAX_LEVELS levels, packed by nb_level_pack
+//   uvec4 neural_levels[];         // std430: NB_GRID_MAX_LEVELS levels, packed by nb_level_pack, then the
+//                                  // y-pair word NB_LEVEL_YPAIR_WORD (shared/hashgrid.h)
 //   uvec2 neural_grid[];           // scalar: one entry = 4 fp16 features packed in 2 words (neural_gpu.h)
+//   uvec4 neural_grid_y[];         // with NB_GATHER_YPAIR: the same buffer in 16-byte words (the y-pair table)
 #ifndef NB_NEURAL_GRID_GLSL
 #define NB_NEURAL_GRID_GLSL
 #include "shared/hashgrid.h"
@@ -32,7 +34,8 @@ vec4 nb_neural_level_features(vec3 p, uint l) {
     uvec4 yp = neural_levels[NB_LEVEL_YPAIR_WORD]; // (table base, y-paired levels, 0, 0)
     if (l < yp.y) {
         // Corners c and c|2 in one load (shared/hashgrid.h y-pair table); the same words.
-        for (uint c = 0u; c < NB_GRID_CORNERS; c += (c & 1u) != 0u ? 3u : 1u) { // 0, 1, 4, 5
+        for (uint k = 0u; k < 4u; ++k) {
+            uint c = (k & 1u) | ((k & 2u) << 1u); // corners 0, 1, 4, 5 (y bit 0)
             uvec4 t = neural_grid_y[yp.x + nb_grid_corner_entry(lv, cell, c)];
             e[c] = t.xy;
             e[c + 2u] = t.zw;
@@ -100,7 +103,8 @@ void nb_neural_paired_sums(uvec2 ea[NB_GATHER_LEVELS * 4u], uvec2 eb[NB_GATHER_L
 // and fractions of both queries, then LOAD (ea and eb [g * 4 .. g * 4 + 3]: the lane's 4 corners of each
 // query), then the sums. Each form instantiates it whole: a form that chose the loads per batch and then
 // summed once took the gather kernel from 56 to 127 registers (the loaded words merged from the two
-// paths; results/neural/ypair_variants_h200.txt).
+// paths; results/neural/ypair_variants_h200.txt). LOAD must hold no comma outside parentheses (one macro
+// argument).
 // A loop of ONE iteration on purpose: the same code without it (straight-line) ran 0.43 instead of 0.57 G
 // queries/s in the v15 kernel (results/neural/README.md), presumably because the driver then schedules the
 // level loop around it differently (more registers, fewer resident warps).

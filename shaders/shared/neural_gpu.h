@@ -54,8 +54,8 @@ struct GpuNeuralEvalPush {
 NB_STATIC_ASSERT(sizeof(GpuNeuralEvalPush) == 48, "GpuNeuralEvalPush layout");
 
 // Bindings of the eval kernels (set 0).
-#define NB_NEVAL_BIND_LEVELS 0u   // GpuHashLevel[NB_GRID_MAX_LEVELS]
-#define NB_NEVAL_BIND_GRID 1u     // uint[]: fp16 pairs, entry e = words 2e, 2e+1 (features 0..3)
+#define NB_NEVAL_BIND_LEVELS 0u   // uvec4[]: NB_GRID_MAX_LEVELS levels (nb_level_pack), then NB_LEVEL_YPAIR_WORD
+#define NB_NEVAL_BIND_GRID 1u     // uint[]: fp16 pairs, entry e = words 2e, 2e+1 (features 0..3); then the y-pair table (hashgrid.h)
 #define NB_NEVAL_BIND_MLP 2u      // uint[]: fp16 pairs, NB_MLP_WEIGHT_COUNT / 2 words (coopmat: transposed)
 #define NB_NEVAL_BIND_QUERIES 3u  // GpuNeuralQuery[]
 #define NB_NEVAL_BIND_HITS 4u     // GpuNeuralHit[]

@@ -44,14 +44,42 @@ TEST(NeuralGridPack, YPairLevelsAreTheLeadingDensePowerOfTwoOnes) {
     const PackedGrid g = pack_grid(six);
     EXPECT_EQ(g.ypair_levels, 0u);
     EXPECT_EQ(g.ypair_entries, 0u);
-    EXPECT_EQ(g.words.size() * 4, packed_grid_bytes(six));
+    const GridLayout layout = grid_layout(six);
+    EXPECT_EQ(g.words.size() * 4, layout.entry_bytes + layout.ypair_bytes);
+    EXPECT_EQ(layout.ypair_bytes, 0u);
+}
+
+// A binding limit smaller than the whole buffer drops y-paired levels, finest first, until it fits
+// (lavapipe's 128 MiB would not hold a 2^22 model's grid with its 2.4M-entry table otherwise).
+TEST(NeuralGridPack, TableShrinksToTheBindingLimit) {
+    const NeuralModel m = model_with(8, 2.0f, 18);
+    const GridLayout whole = grid_layout(m);
+    ASSERT_EQ(whole.ypair_levels, 4u);
+    EXPECT_EQ(whole.ypair_bytes, uint64_t(512 + 4096 + 32768 + 262144) * 16);
+    // Room for levels 0-2 only: level 3 (2^18 entries, 4 MiB of table) is dropped.
+    const GridLayout three = grid_layout(m, whole.entry_bytes + whole.ypair_bytes - 1);
+    EXPECT_EQ(three.ypair_levels, 3u);
+    EXPECT_EQ(three.ypair_entries, 512u + 4096u + 32768u);
+    const PackedGrid g = pack_grid(m, whole.entry_bytes + whole.ypair_bytes - 1);
+    EXPECT_EQ(g.ypair_levels, 3u);
+    EXPECT_EQ(g.words.size() * 4, three.entry_bytes + three.ypair_bytes);
+    // No room at all: the entries alone (the renderer's own limit checks refuse a grid larger than that).
+    EXPECT_EQ(grid_layout(m, whole.entry_bytes).ypair_levels, 0u);
+    EXPECT_EQ(grid_layout(m, 1).ypair_levels, 0u);
 }
 
 TEST(NeuralGridPack, TableHoldsEachVertexAndItsYNeighbour) {
-    for (uint32_t log2_hash : {14u, 18u}) {
-        const NeuralModel m = model_with(8, 2.0f, log2_hash);
+    // Paper sizes at 2^14 (2 levels paired) and 2^18 (4), and base resolution 3: 3^3 = 27 entries padded
+    // to 32, a power of two, so the row-major index wraps by the padded size (level 0 paired; 6^3 is not).
+    struct Case {
+        uint32_t base, log2_hash, levels;
+    };
+    for (const Case& k : {Case{8, 14, 2}, Case{8, 18, 4}, Case{3, 14, 1}}) {
+        const NeuralModel m = model_with(k.base, 2.0f, k.log2_hash);
         const PackedGrid g = pack_grid(m);
-        ASSERT_EQ(g.words.size() * 4, packed_grid_bytes(m));
+        ASSERT_EQ(g.ypair_levels, k.levels) << "base " << k.base << " hash 2^" << k.log2_hash;
+        const GridLayout layout = grid_layout(m);
+        ASSERT_EQ(g.words.size() * 4, layout.entry_bytes + layout.ypair_bytes);
         ASSERT_EQ(g.ypair_base * 4, (g.words.size() - size_t(g.ypair_entries) * 4)); // the table ends the buffer
         ASSERT_GE(g.ypair_base * 2, neural::level_table_entries(m.levels));          // after every entry
         const uvec4 w = ypair_word(g);
