@@ -319,8 +319,9 @@ void NeuralEvaluator::set_pipeline(const Pipeline& p) {
 NeuralEvaluator::Pipeline NeuralEvaluator::pipeline_for(const vk::DeviceFeatures& dev) {
     Pipeline p;
     if (dev.sm_count == 0) return p; // one chunk, the gather grid as large as the chunk (uncapped)
-    // H200 (132 SMs), 4M random queries: 8 chunks 2.959 ms against 3.547 for the plain split query; 4
-    // and 16 chunks 2.990 / 3.069 (results/neural/README.md).
+    // H200 (132 SMs), 4M random queries, 148feeb (the y-pair gather): 8 chunks 2.685 ms against 3.190 for
+    // the plain split query; 4 and 16 chunks 2.711 / 2.780 (results/neural/bench_neural_random_h200.txt;
+    // at c5a2e8e, before the y-pair gather, 2.959 / 2.990 / 3.069 against 3.547).
     p.chunks = 8;
     p.groups = SPLIT_GATHER_GROUPS_PER_SM * dev.sm_count;
     return p;

@@ -104,8 +104,8 @@ private:
 };
 
 // Workgroups per SM of the pipelined split query's gather grids (NeuralEvaluator part 6): H200, 4M
-// random queries, 8 chunks: 4, 6 and 8 per SM 3.190 / 2.959 / 2.966 ms, 12 and 16 per SM 3.44-3.47
-// (results/neural/README.md). The renderer's split pass is not pipelined: its queries are coherent
+// random queries, 8 chunks, 148feeb: 4, 6 and 8 per SM 2.903 / 2.685 / 2.683 ms (at c5a2e8e, before the
+// y-pair gather: 3.190 / 2.959 / 2.966, and 12 and 16 per SM 3.44-3.47; results/neural/). The renderer's split pass is not pipelined: its queries are coherent
 // enough that it ran slower so (results/perf/dropped/README.md).
 inline constexpr uint32_t SPLIT_GATHER_GROUPS_PER_SM = 6;
 
